@@ -1,0 +1,141 @@
+//! `cargo xtask bench barnet`: accuracy versus time of the bar-net (spec §9).
+//!
+//! 1. Net resolution: the analytic membrane (spec 7.1 c) at N = 8 … 287 (quick: … 71): shape
+//!    error against the exact solution, equilibrium residual, factorisation time and time per
+//!    frame (constant q: one right-hand side and three back-substitutions).
+//! 2. Fine-mesh resolution on the arm: Catmull–Clark levels 0–3, whole-frame time (LBS, bar-net
+//!    and subdivision) against the distance of the level-L vertices to their level-4 positions
+//!    (coarse vertices keep their indices across levels, so this is the vertex-wise convergence
+//!    to the limit surface).
+//!
+//! Writes `accuracy_vs_time.csv`, `fine_levels.csv`, `accuracy_vs_time.png`, `fine_levels.png`.
+
+use std::time::Instant;
+
+use barnet::analytic;
+use barnet::deformer::{
+    BarNetDeformer, DeformerConfig, DirLocal, DriverSpec, Drivers, FineSpec, FrameOutput, LoadSpec, NodeSet,
+};
+use barnet::subdiv::{self, Scheme};
+use barnet::{FdmOptions, FdmSolver};
+use geom_core::math::{Iso3, Pt3};
+
+use crate::error::{Error, Result};
+use crate::out::{CsvWriter, Summary};
+use crate::plot::{LinePlot, Series};
+use crate::registry::BenchCtx;
+
+fn bn(e: barnet::BarNetError) -> Error {
+    Error::Run(format!("barnet: {e}"))
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn arm_config(levels: u32) -> DeformerConfig {
+    DeformerConfig {
+        arm: Default::default(),
+        ramp_half_width: 0.04,
+        free: NodeSet::Named("biceps_triceps_12".into()),
+        q: 1.0,
+        groups: vec![],
+        loads: vec![LoadSpec {
+            name: "biceps_bulge".into(),
+            nodes: NodeSet::Named("biceps_mid".into()),
+            dir_local: DirLocal::Radial,
+            driver: DriverSpec::JointAngle { joint: "elbow".into() },
+            curve: vec![(0.0, 0.0), (1.57, 0.6), (2.4, 1.0)],
+            scale: 0.02,
+        }],
+        stiffness: vec![],
+        fine: FineSpec::Subdivision { scheme: Scheme::CatmullClark, levels },
+        max_disp: None,
+    }
+}
+
+/// Runs the sweep; see the module docs.
+pub fn run(ctx: &BenchCtx) -> Result<Summary> {
+    let mut s = Summary::new();
+    // 1. Net resolution.
+    let ns: &[usize] = if ctx.quick { &[8, 17, 35, 71] } else { &[8, 17, 35, 71, 143, 287] };
+    let mut csv = CsvWriter::create(
+        &ctx.out_dir.join("accuracy_vs_time.csv"),
+        &["N", "free_nodes", "shape_err", "residual", "factor_s", "frame_s"],
+    )?;
+    let (mut pts, mut fpts) = (Vec::new(), Vec::new());
+    let mut max_res: f64 = 0.0;
+    for &n in ns {
+        let c = analytic::membrane(n, 1.0);
+        let (loads, fixed) = c.split();
+        let t0 = Instant::now();
+        let solver = FdmSolver::new(&c.net, &FdmOptions::default()).map_err(bn)?;
+        let tf = t0.elapsed().as_secs_f64();
+        let mut x = Vec::new();
+        let mut times = Vec::new();
+        let mut res = 0.0;
+        for _ in 0..5 {
+            let t = Instant::now();
+            res = solver.solve_into(&loads, &fixed, &mut x).map_err(bn)?.rel_residual;
+            times.push(t.elapsed().as_secs_f64());
+        }
+        let tsol = median(times);
+        let err = analytic::max_abs_err(&x, c.exact.as_ref().expect("membrane has an exact solution"), 2);
+        max_res = max_res.max(res);
+        pts.push((tsol, err));
+        fpts.push((tf, err));
+        csv.row(&[n.into(), loads.len().into(), err.into(), res.into(), tf.into(), tsol.into()])?;
+    }
+    s.set("membrane_max_equilibrium_residual", max_res);
+    if let Some(&(t, e)) = pts.last() {
+        s.set("membrane_finest_shape_err", e);
+        s.set("membrane_finest_frame_s", t);
+    }
+    LinePlot::new("Membrane net: shape error vs time", "time (s)", "max nodal error vs exact")
+        .log(true, true)
+        .with(Series::new("per frame (back-substitution)", pts))
+        .with(Series::new("factorisation", fpts))
+        .write_png(&ctx.out_dir.join("accuracy_vs_time.png"))?;
+    // 2. Fine-mesh resolution on the arm.
+    let arm = barnet::arm::Arm::new(&Default::default()).map_err(bn)?;
+    let max_level = if ctx.quick { 3 } else { 4 };
+    let (reference, _) = subdiv::catmull_clark(&arm.mesh, max_level).map_err(bn)?;
+    let mut csv =
+        CsvWriter::create(&ctx.out_dir.join("fine_levels.csv"), &["level", "fine_vertices", "geom_err_m", "frame_s"])?;
+    let mut lpts = Vec::new();
+    for level in 0..max_level {
+        let (fine, _) = subdiv::catmull_clark(&arm.mesh, level).map_err(bn)?;
+        let err = fine
+            .positions
+            .iter()
+            .zip(&reference.positions)
+            .map(|(a, b): (&Pt3, &Pt3)| (a - b).norm())
+            .fold(0.0, f64::max);
+        let mut d = BarNetDeformer::new(&arm_config(level)).map_err(bn)?;
+        let pose = d.arm_pose(1.5, &Iso3::identity()).map_err(bn)?;
+        let drv = Drivers { joint_angles: vec![0.0, 1.5, 0.0], time: 0.0 };
+        let mut out = FrameOutput::default();
+        let mut times = Vec::new();
+        for _ in 0..21 {
+            d.deform(&pose, &drv, &mut out).map_err(bn)?;
+            times.push(out.timings.total);
+        }
+        let t = median(times);
+        lpts.push((t, err));
+        csv.row(&[(level as usize).into(), fine.positions.len().into(), err.into(), t.into()])?;
+        if level == 2 {
+            s.set("arm_frame_s_level2", t);
+        }
+    }
+    LinePlot::new(
+        "Arm: fine-mesh geometric error vs time per frame",
+        "time per frame (s)",
+        "distance to level-max vertices (m)",
+    )
+    .log(true, true)
+    .with(Series::new("Catmull-Clark levels 0..", lpts))
+    .write_png(&ctx.out_dir.join("fine_levels.png"))?;
+    s.set_str("timing_profile", if cfg!(debug_assertions) { "dev" } else { "release" });
+    Ok(s)
+}

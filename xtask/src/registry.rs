@@ -1,0 +1,162 @@
+//! What `cargo xtask` knows: the scene runners and benchmarks each crate registers, and the
+//! built-in scene files under `scenes/<crate>/<scene>.ron`.
+//!
+//! A crate joins by adding a module under `scenes/` (its runners) and/or a benchmark, and one line
+//! in [`runners`] / [`benches`]. Built-in scenes are discovered from the scene directory, so adding
+//! a scene of an existing runner is adding a file.
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{io_err, Error, Result};
+use crate::out::Summary;
+use crate::scene::{self, Mode};
+
+/// What a runner is given.
+#[derive(Clone, Debug)]
+pub struct RunCtx {
+    /// `<crate>/<scene>`.
+    pub scene_id: String,
+    /// The scene file.
+    pub scene_file: PathBuf,
+    /// Run size.
+    pub mode: Mode,
+    /// Where every output goes (created before the runner is called).
+    pub out_dir: PathBuf,
+}
+
+/// A scene runner: reads its parameters from the scene file, computes, writes outputs into
+/// `out_dir`, and returns the figures of `summary.json`.
+pub struct Runner {
+    /// The `method` a scene file names to use this runner.
+    pub method: &'static str,
+    /// The entry point.
+    pub run: fn(&RunCtx) -> Result<Summary>,
+}
+
+/// What a benchmark is given.
+#[derive(Clone, Debug)]
+pub struct BenchCtx {
+    /// Reduced sweep (smoke test).
+    pub quick: bool,
+    /// `out/bench/<crate>/` (created before the benchmark is called).
+    pub out_dir: PathBuf,
+}
+
+/// An accuracy-versus-time benchmark of one crate.
+pub struct Bench {
+    /// The crate name, as in `cargo xtask bench <crate>`.
+    pub crate_name: &'static str,
+    /// One line saying what it sweeps.
+    pub description: &'static str,
+    /// The entry point: writes CSV and PNG into `out_dir` and returns the summary figures.
+    pub run: fn(&BenchCtx) -> Result<Summary>,
+}
+
+/// Every scene runner of every crate.
+pub fn runners() -> Vec<Runner> {
+    let mut v = Vec::new();
+    crate::scenes::geom_core::register(&mut v);
+    crate::scenes::curve_skin::register(&mut v); // TEMP-CURVESKIN
+    crate::scenes::shells::register(&mut v); // TEMP-SHELLS
+    v
+}
+
+/// Every benchmark of every crate.
+pub fn benches() -> Vec<Bench> {
+    vec![Bench {
+        crate_name: "geom-core",
+        description: "sparse solvers: direct factorisation, refactorisation and IC(0)-PCG on Laplacian + mass systems",
+        run: crate::bench_geom_core::run,
+    }, Bench { crate_name: "curve-skin", description: "TEMP-CURVESKIN", run: crate::bench_curve_skin::run }, Bench { crate_name: "shells", description: "TEMP-SHELLS", run: crate::bench_shells::run }]
+}
+
+/// A built-in scene file.
+#[derive(Clone, Debug)]
+pub struct BuiltinScene {
+    /// `<crate>/<scene>` (the file's directory and stem).
+    pub id: String,
+    /// The scene file.
+    pub file: PathBuf,
+    /// Its runner.
+    pub method: String,
+    /// Its one-line description.
+    pub description: String,
+}
+
+/// Every built-in scene under `scenes/`, sorted by id.
+pub fn builtin_scenes() -> Result<Vec<BuiltinScene>> {
+    builtin_scenes_in(&scene::scenes_dir())
+}
+
+/// Every scene file under `dir/<crate>/*.ron`, sorted by id.
+pub fn builtin_scenes_in(dir: &Path) -> Result<Vec<BuiltinScene>> {
+    let mut out = Vec::new();
+    if !dir.exists() {
+        return Ok(out);
+    }
+    let mut crates: Vec<PathBuf> =
+        std::fs::read_dir(dir).map_err(io_err(dir))?.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    crates.sort();
+    for c in crates.into_iter().filter(|p| p.is_dir()) {
+        let crate_name = c.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let mut files: Vec<PathBuf> = std::fs::read_dir(&c)
+            .map_err(io_err(&c))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+            .collect();
+        files.sort();
+        for f in files {
+            let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            let h = scene::load_header(&f)?;
+            out.push(BuiltinScene { id: format!("{crate_name}/{stem}"), file: f, method: h.method, description: h.description });
+        }
+    }
+    Ok(out)
+}
+
+/// Resolves a `run` target: a built-in `<crate>/<scene>` or a path to a `.ron` file. Returns the
+/// scene id (a user file gets `<crate>/<file stem>`, the crate taken from its runner) and the file.
+pub fn resolve_target(target: &str) -> Result<(String, PathBuf)> {
+    let as_path = Path::new(target);
+    if target.ends_with(".ron") || as_path.is_file() {
+        let h = scene::load_header(as_path)?;
+        let crate_name = h.method.split('/').next().unwrap_or("scene").to_string();
+        let stem = as_path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
+        return Ok((format!("{crate_name}/{stem}"), as_path.to_path_buf()));
+    }
+    let scenes = builtin_scenes()?;
+    match scenes.iter().find(|s| s.id == target) {
+        Some(s) => Ok((s.id.clone(), s.file.clone())),
+        None => {
+            let close: Vec<&str> = scenes
+                .iter()
+                .filter(|s| s.id.split('/').next() == target.split('/').next())
+                .map(|s| s.id.as_str())
+                .collect();
+            Err(Error::Usage(format!(
+                "no built-in scene '{target}' and no such .ron file{}; `cargo xtask list` shows every scene",
+                if close.is_empty() { String::new() } else { format!(" (this crate has: {})", close.join(", ")) }
+            )))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_scene_has_a_runner_and_description() {
+        let names: Vec<&str> = runners().iter().map(|r| r.method).collect();
+        for s in builtin_scenes().unwrap() {
+            assert!(names.contains(&s.method.as_str()), "{}: no runner '{}'", s.id, s.method);
+            assert!(!s.description.is_empty(), "{}: empty description", s.id);
+        }
+    }
+
+    #[test]
+    fn unknown_target_is_a_clear_error() {
+        let e = resolve_target("geom-core/no-such-scene").unwrap_err();
+        assert!(e.to_string().contains("no built-in scene"), "{e}");
+    }
+}
