@@ -8,22 +8,22 @@
 //! Conventions: `f64`, SI units, right-handed; positions are [`math::Pt3`], solvers take flat
 //! `[x0, y0, z0, x1, …]` slices ([`linalg::flat`]); indices are `u32` with [`NONE`] as "no element".
 
-pub mod error;
-pub mod math;
-pub mod rng;
-pub mod graph;
-pub mod mesh;
-pub mod io;
-pub mod procedural;
-pub mod linalg;
-pub mod spatial;
-pub mod query;
-#[cfg(feature = "parry")]
-pub mod collide;
 #[cfg(feature = "anim")]
 pub mod anim;
+#[cfg(feature = "parry")]
+pub mod collide;
+pub mod error;
+pub mod graph;
 pub mod image;
+pub mod io;
+pub mod linalg;
+pub mod math;
+pub mod mesh;
+pub mod procedural;
+pub mod query;
 pub mod raster;
+pub mod rng;
+pub mod spatial;
 
 pub use error::{BvhError, Error, Result};
 pub use faer;

@@ -101,7 +101,7 @@ pub fn diagnose(m: &PolyMesh) -> MeshDiagnosis {
         }
         let [a, b, c] = t.map(|v| m.positions[v as usize]);
         let area = 0.5 * (b - a).cross(&(c - a)).norm();
-        if !(area > 1e-14 * diag2) {
+        if area.is_nan() || area <= 1e-14 * diag2 {
             d.degenerate_faces.push(fi as u32);
         }
         for k in 0..3 {
@@ -193,14 +193,19 @@ impl MeshDiagnosis {
         use std::fmt::Write as _;
         let list = |v: &[u32]| {
             let shown: Vec<String> = v.iter().take(10).map(|x| x.to_string()).collect();
-            format!("{}{}", shown.join(", "), if v.len() > 10 { format!(", … ({} in all)", v.len()) } else { String::new() })
+            format!(
+                "{}{}",
+                shown.join(", "),
+                if v.len() > 10 { format!(", … ({} in all)", v.len()) } else { String::new() }
+            )
         };
         let mut s = String::new();
         let _ = writeln!(s, "  vertices            {}", self.vertices);
         let _ = writeln!(s, "  polygons            {} ({} triangles)", self.polygons, self.triangles);
         match self.bounds {
             Some((lo, hi)) => {
-                let _ = writeln!(
+                let _ =
+                    writeln!(
                     s,
                     "  bounds              [{:.6}, {:.6}, {:.6}] – [{:.6}, {:.6}, {:.6}] (size {:.6} × {:.6} × {:.6})",
                     lo.x, lo.y, lo.z, hi.x, hi.y, hi.z, hi.x - lo.x, hi.y - lo.y, hi.z - lo.z
@@ -225,13 +230,21 @@ impl MeshDiagnosis {
         if !self.non_manifold_vertices.is_empty() {
             let _ = writeln!(s, "      {}", list(&self.non_manifold_vertices));
         }
-        let _ = writeln!(s, "  inconsistent edges  {} (neighbouring faces with opposite orientation)", self.inconsistent_edges);
+        let _ = writeln!(
+            s,
+            "  inconsistent edges  {} (neighbouring faces with opposite orientation)",
+            self.inconsistent_edges
+        );
         let _ = writeln!(s, "  degenerate faces    {}", self.degenerate_faces.len());
         if !self.degenerate_faces.is_empty() {
             let _ = writeln!(s, "      triangles {}", list(&self.degenerate_faces));
         }
         let closed = self.boundary_edges == 0 && self.non_manifold_edges.is_empty() && self.triangles > 0;
-        let _ = writeln!(s, "  closed manifold     {}", if closed && self.non_manifold_vertices.is_empty() { "yes" } else { "no" });
+        let _ = writeln!(
+            s,
+            "  closed manifold     {}",
+            if closed && self.non_manifold_vertices.is_empty() { "yes" } else { "no" }
+        );
         s
     }
 }
@@ -264,9 +277,19 @@ mod tests {
         // Three triangles on edge (0,1) (non-manifold edge), a flipped face, a degenerate face,
         // two fans meeting at vertex 6 (bow tie), an unreferenced vertex.
         let p = [
-            [0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, -1.0, 0.0], [0.5, 0.0, 1.0],
-            [2.0, 0.0, 0.0], [3.0, 0.0, 0.0], [4.0, 1.0, 0.0], [4.0, -1.0, 0.0], [2.0, 1.0, 0.0],
-            [2.0, -1.0, 0.0], [9.0, 9.0, 9.0], [5.0, 5.0, 5.0],
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.5, 0.0, 1.0],
+            [2.0, 0.0, 0.0],
+            [3.0, 0.0, 0.0],
+            [4.0, 1.0, 0.0],
+            [4.0, -1.0, 0.0],
+            [2.0, 1.0, 0.0],
+            [2.0, -1.0, 0.0],
+            [9.0, 9.0, 9.0],
+            [5.0, 5.0, 5.0],
         ];
         let f: &[&[u32]] = &[&[0, 1, 2], &[1, 0, 3], &[0, 1, 4], &[6, 7, 8], &[6, 9, 10], &[5, 5, 6]];
         let d = diagnose(&poly(&p, f));

@@ -2,9 +2,8 @@
 //! accuracy-versus-time benchmarks, inspect mesh and motion files, and reproduce every paper
 //! experiment into one report.
 
+mod bench_barnet;
 mod bench_geom_core;
-mod bench_curve_skin; // TEMP-CURVESKIN
-mod bench_shells; // TEMP-SHELLS
 mod error;
 mod inspect;
 mod out;
@@ -116,7 +115,7 @@ fn list() -> error::Result<()> {
     let width = scenes.iter().map(|s| s.id.len()).max().unwrap_or(0);
     println!("scenes (cargo xtask run <id> [--quick | --full]):");
     for s in &scenes {
-        println!("  {:width$}  {}", s.id, s.description);
+        println!("  {:width$}  {}  [{}]", s.id, s.description, s.method);
     }
     println!("benchmarks (cargo xtask bench <crate> [--quick]):");
     for b in registry::benches() {

@@ -67,13 +67,6 @@ impl Summary {
         self.values.iter()
     }
 
-    /// Merges another summary's keys, each prefixed with `prefix`.
-    pub fn merge_prefixed(&mut self, prefix: &str, other: &Summary) {
-        for (k, v) in &other.values {
-            self.values.insert(format!("{prefix}{k}"), v.clone());
-        }
-    }
-
     /// Writes `dir/summary.json` (pretty-printed, keys sorted).
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         ensure_dir(dir)?;
@@ -86,8 +79,8 @@ impl Summary {
     /// Reads a `summary.json` back.
     pub fn read(path: &Path) -> Result<Summary> {
         let text = fs::read_to_string(path).map_err(io_err(path))?;
-        let values: BTreeMap<String, serde_json::Value> = serde_json::from_str(&text)
-            .map_err(|e| crate::error::Error::Run(format!("{}: {e}", path.display())))?;
+        let values: BTreeMap<String, serde_json::Value> =
+            serde_json::from_str(&text).map_err(|e| crate::error::Error::Run(format!("{}: {e}", path.display())))?;
         Ok(Summary { values })
     }
 }

@@ -88,9 +88,8 @@ impl LinePlot {
             crate::out::ensure_dir(dir)?;
         }
         let plot_err = |e: &dyn std::fmt::Display| Error::Plot { path: path.to_path_buf(), msg: e.to_string() };
-        let keep = |x: f64, y: f64| {
-            x.is_finite() && y.is_finite() && (!self.log_x || x > 0.0) && (!self.log_y || y > 0.0)
-        };
+        let keep =
+            |x: f64, y: f64| x.is_finite() && y.is_finite() && (!self.log_x || x > 0.0) && (!self.log_y || y > 0.0);
         let pts: Vec<(f64, f64)> =
             self.series.iter().flat_map(|s| s.points.iter().copied()).filter(|&(x, y)| keep(x, y)).collect();
         let range = |vals: Vec<f64>, log: bool| -> (f64, f64) {
@@ -113,11 +112,7 @@ impl LinePlot {
         let root = BitMapBackend::new(path, (900, 600)).into_drawing_area();
         root.fill(&WHITE).map_err(|e| plot_err(&e))?;
         let mut builder = ChartBuilder::on(&root);
-        builder
-            .caption(&self.title, ("sans-serif", 22))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(80);
+        builder.caption(&self.title, ("sans-serif", 22)).margin(15).x_label_area_size(45).y_label_area_size(80);
         // plotters types the chart by its coordinate kinds, so the four axis combinations are four
         // instantiations of one generic drawing routine.
         macro_rules! draw {

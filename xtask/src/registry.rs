@@ -14,8 +14,6 @@ use crate::scene::{self, Mode};
 /// What a runner is given.
 #[derive(Clone, Debug)]
 pub struct RunCtx {
-    /// `<crate>/<scene>`.
-    pub scene_id: String,
     /// The scene file.
     pub scene_file: PathBuf,
     /// Run size.
@@ -56,18 +54,24 @@ pub struct Bench {
 pub fn runners() -> Vec<Runner> {
     let mut v = Vec::new();
     crate::scenes::geom_core::register(&mut v);
-    crate::scenes::curve_skin::register(&mut v); // TEMP-CURVESKIN
-    crate::scenes::shells::register(&mut v); // TEMP-SHELLS
+    crate::scenes::barnet::register(&mut v);
     v
 }
 
 /// Every benchmark of every crate.
 pub fn benches() -> Vec<Bench> {
-    vec![Bench {
-        crate_name: "geom-core",
-        description: "sparse solvers: direct factorisation, refactorisation and IC(0)-PCG on Laplacian + mass systems",
-        run: crate::bench_geom_core::run,
-    }, Bench { crate_name: "curve-skin", description: "TEMP-CURVESKIN", run: crate::bench_curve_skin::run }, Bench { crate_name: "shells", description: "TEMP-SHELLS", run: crate::bench_shells::run }]
+    vec![
+        Bench {
+            crate_name: "geom-core",
+            description: "sparse solvers: direct factorisation, refactorisation and IC(0)-PCG on Laplacian + mass systems",
+            run: crate::bench_geom_core::run,
+        },
+        Bench {
+            crate_name: "barnet",
+            description: "bar-net: membrane resolution vs shape error and time per frame; Catmull-Clark level vs error and arm frame time",
+            run: crate::bench_barnet::run,
+        },
+    ]
 }
 
 /// A built-in scene file.
@@ -108,7 +112,12 @@ pub fn builtin_scenes_in(dir: &Path) -> Result<Vec<BuiltinScene>> {
         for f in files {
             let stem = f.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
             let h = scene::load_header(&f)?;
-            out.push(BuiltinScene { id: format!("{crate_name}/{stem}"), file: f, method: h.method, description: h.description });
+            out.push(BuiltinScene {
+                id: format!("{crate_name}/{stem}"),
+                file: f,
+                method: h.method,
+                description: h.description,
+            });
         }
     }
     Ok(out)

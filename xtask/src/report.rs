@@ -155,7 +155,11 @@ pub fn write_report(report_dir: &Path, outcomes: &[Outcome], mode: Mode, total_s
 }
 
 fn anchor(id: &str) -> String {
-    id.to_lowercase().chars().filter(|c| c.is_alphanumeric() || *c == '-' || *c == ' ').collect::<String>().replace(' ', "-")
+    id.to_lowercase()
+        .chars()
+        .filter(|c| c.is_alphanumeric() || *c == '-' || *c == ' ')
+        .collect::<String>()
+        .replace(' ', "-")
 }
 
 fn pngs(dir: &Path) -> Result<Vec<PathBuf>> {

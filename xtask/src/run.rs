@@ -30,10 +30,10 @@ pub fn run_scene(scene_id: &str, file: &Path, mode: Mode, out_dir: &Path) -> Res
     let runners = registry::runners();
     let runner = runners.iter().find(|r| r.method == header.method).ok_or_else(|| {
         let known: Vec<&str> = runners.iter().map(|r| r.method).collect();
-        scene::invalid(file, format!("unknown method '{}'; known: {}", header.method, known.join(", ")))
+        scene::invalid(file, format!("{scene_id}: unknown method '{}'; known: {}", header.method, known.join(", ")))
     })?;
     ensure_dir(out_dir)?;
-    let ctx = RunCtx { scene_id: scene_id.to_string(), scene_file: file.to_path_buf(), mode, out_dir: out_dir.to_path_buf() };
+    let ctx = RunCtx { scene_file: file.to_path_buf(), mode, out_dir: out_dir.to_path_buf() };
     let t0 = Instant::now();
     let mut summary = (runner.run)(&ctx)?;
     summary.set("wall_s", t0.elapsed().as_secs_f64());

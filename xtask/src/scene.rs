@@ -96,7 +96,14 @@ pub fn load_header(path: &Path) -> Result<SceneHeader> {
 
 /// Reads a whole scene file with typed parameters.
 pub fn load<P: DeserializeOwned>(path: &Path) -> Result<SceneFile<P>> {
-    parse(path, &read_text(path)?)
+    let sc: SceneFile<P> = parse(path, &read_text(path)?)?;
+    if !sc.method.contains('/') {
+        return Err(invalid(path, format!("method '{}' must be <crate>/<runner>", sc.method)));
+    }
+    if sc.description.trim().is_empty() {
+        return Err(invalid(path, "description is empty: say in one line what the scene shows"));
+    }
+    Ok(sc)
 }
 
 /// An error about a scene's content found after parsing (an out-of-range parameter): names the

@@ -77,17 +77,20 @@ impl Preconditioner for Jacobi {
 }
 
 /// Incomplete Cholesky `M = L Lᵀ` with zero fill, IC(0) or MIC(0); see the module docs.
-/// Applying it is two sequential triangular solves (deterministic).
+///
+/// Stored as `M = L̂ D² L̂ᵀ` with `L̂ = L D⁻¹` unit lower triangular and `D = diag(L)`, so that
+/// applying `M⁻¹` is two sequential triangular solves without divisions (their dependency
+/// chains are latency-bound) and one diagonal scaling. Deterministic.
 #[derive(Clone, Debug)]
 pub struct Ic0 {
     n: usize,
-    /// Strictly lower part of `L` by columns: rows of column `k` are
+    /// Strictly lower part of `L̂` by columns: rows of column `k` are
     /// `row[col_ptr[k]..col_ptr[k + 1]]`, increasing.
     col_ptr: Vec<usize>,
     row: Vec<u32>,
     val: Vec<f64>,
-    /// Diagonal of `L`.
-    diag: Vec<f64>,
+    /// `1 / L_kk²`.
+    inv_d2: Vec<f64>,
     /// Number of pivots replaced by the `σ` safety rule.
     replaced: usize,
 }
@@ -133,7 +136,7 @@ impl Ic0 {
         }
         // Right-looking elimination restricted to the pattern; `d` holds the running pivots.
         let mut d = a_diag.clone();
-        let mut diag = vec![0.0; n];
+        let mut lkk_all = vec![0.0; n];
         let mut replaced = 0;
         for k in 0..n {
             let mut dk = d[k];
@@ -144,7 +147,7 @@ impl Ic0 {
                 replaced += 1;
             }
             let lkk = dk.sqrt();
-            diag[k] = lkk;
+            lkk_all[k] = lkk;
             let (s, e) = (col_ptr[k], col_ptr[k + 1]);
             for v in &mut val[s..e] {
                 *v /= lkk;
@@ -170,7 +173,14 @@ impl Ic0 {
                 }
             }
         }
-        Ok(Self { n, col_ptr, row, val, diag, replaced })
+        // L̂ = L D⁻¹: scale column k by 1 / L_kk.
+        for k in 0..n {
+            for v in &mut val[col_ptr[k]..col_ptr[k + 1]] {
+                *v /= lkk_all[k];
+            }
+        }
+        let inv_d2 = lkk_all.iter().map(|l| 1.0 / (l * l)).collect();
+        Ok(Self { n, col_ptr, row, val, inv_d2, replaced })
     }
 
     /// How many pivots were replaced by `a_kk` (the `σ = 0.25` safety rule).
@@ -183,21 +193,26 @@ impl Preconditioner for Ic0 {
     fn apply(&self, r: &[f64], z: &mut [f64]) {
         debug_assert!(r.len() == self.n && z.len() == self.n);
         z.copy_from_slice(r);
-        // Forward: L y = r, column-oriented.
+        // Forward: L̂ w = r, column-oriented (unit diagonal).
         for k in 0..self.n {
-            let yk = z[k] / self.diag[k];
-            z[k] = yk;
-            for p in self.col_ptr[k]..self.col_ptr[k + 1] {
-                z[self.row[p] as usize] -= self.val[p] * yk;
+            let wk = z[k];
+            let (s, e) = (self.col_ptr[k], self.col_ptr[k + 1]);
+            for (&i, &v) in self.row[s..e].iter().zip(&self.val[s..e]) {
+                z[i as usize] -= v * wk;
             }
         }
-        // Backward: Lᵀ x = y (row k of Lᵀ is column k of L).
+        // y = D⁻² w.
+        for (zk, s) in z.iter_mut().zip(&self.inv_d2) {
+            *zk *= s;
+        }
+        // Backward: L̂ᵀ x = y (row k of L̂ᵀ is column k of L̂).
         for k in (0..self.n).rev() {
-            let mut s = z[k];
-            for p in self.col_ptr[k]..self.col_ptr[k + 1] {
-                s -= self.val[p] * z[self.row[p] as usize];
+            let (s, e) = (self.col_ptr[k], self.col_ptr[k + 1]);
+            let mut acc = z[k];
+            for (&i, &v) in self.row[s..e].iter().zip(&self.val[s..e]) {
+                acc -= v * z[i as usize];
             }
-            z[k] = s / self.diag[k];
+            z[k] = acc;
         }
     }
 }

@@ -69,7 +69,7 @@ impl MeshSource {
                     .collect();
                 g.with_positions(p)?
             }
-            MeshSource::File(path) => geom_core::io::obj::read_tri(&crate::out::workspace_root().join(path))?,
+            MeshSource::File(path) => geom_core::io::obj::read_tri(crate::out::workspace_root().join(path))?,
         })
     }
 }
@@ -149,12 +149,23 @@ fn run_subdivision(ctx: &RunCtx) -> Result<Summary> {
     let mut csv = CsvWriter::create(
         &ctx.out_dir.join("levels.csv"),
         &[
-            "mesh", "level", "vertices", "faces", "euler", "prolongation_err", "area_rel_err", "galerkin_mass_err",
-            "laplacian_rowsum_max", "laplacian_asym_max", "subdivide_s", "cotan_s",
+            "mesh",
+            "level",
+            "vertices",
+            "faces",
+            "euler",
+            "prolongation_err",
+            "area_rel_err",
+            "galerkin_mass_err",
+            "laplacian_rowsum_max",
+            "laplacian_asym_max",
+            "subdivide_s",
+            "cotan_s",
         ],
     )?;
     let mut plot = LinePlot::new("linear subdivision: time per level", "faces", "time (s)").log(true, true);
-    let (mut worst_p, mut worst_area, mut worst_galerkin, mut worst_rowsum, mut worst_asym) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut worst_p, mut worst_area, mut worst_galerkin, mut worst_rowsum, mut worst_asym) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for (name, src) in &p.meshes {
         let coarse = src.build()?;
         let area0: f64 = face_areas(&coarse.faces, &coarse.positions).iter().sum();
