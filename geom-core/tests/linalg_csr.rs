@@ -209,3 +209,29 @@ proptest! {
         prop_assert_eq!(y1, y2);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// `FixedPattern` sums each entry's contributions in key order, exactly as
+    /// `Csr::from_triplets` sums duplicates in insertion order: the two agree bitwise, and the
+    /// lower-only pattern equals the triplets of the lower keys.
+    #[test]
+    fn fixed_pattern_equals_triplet_assembly(
+        entries in proptest::collection::vec((0u32..6, 0u32..6, -1e3f64..1e3), 0..60),
+    ) {
+        let keys: Vec<(u32, u32)> = entries.iter().map(|e| (e.0, e.1)).collect();
+        let vals: Vec<f64> = entries.iter().map(|e| e.2).collect();
+        for lower in [false, true] {
+            let mut t = Triplets::new(6, 6);
+            for &(i, j, v) in &entries {
+                if !lower || i >= j {
+                    t.push(i, j, v);
+                }
+            }
+            let mut p = FixedPattern::new(6, 6, &keys, lower);
+            let got = Csr::from_csc(p.assemble(&vals));
+            prop_assert_eq!(got, Csr::from_triplets(&t));
+        }
+    }
+}
