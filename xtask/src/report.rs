@@ -39,7 +39,7 @@ pub fn repro(mode: Mode, out_root: PathBuf) -> Result<()> {
             wall_s: t.elapsed().as_secs_f64(),
             error: r.err().map(|e| e.to_string()),
         };
-        bar.println(status_line(&o));
+        bar.suspend(|| println!("{}", status_line(&o)));
         outcomes.push(o);
         bar.inc(1);
     }
@@ -56,7 +56,7 @@ pub fn repro(mode: Mode, out_root: PathBuf) -> Result<()> {
             wall_s: t.elapsed().as_secs_f64(),
             error: r.err().map(|e| e.to_string()),
         };
-        bar.println(status_line(&o));
+        bar.suspend(|| println!("{}", status_line(&o)));
         outcomes.push(o);
         bar.inc(1);
     }

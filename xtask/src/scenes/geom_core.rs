@@ -337,3 +337,32 @@ fn run_mocap(ctx: &RunCtx) -> Result<Summary> {
     heights.write_png(&ctx.out_dir.join("head_height.png"))?;
     Ok(s)
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::registry::builtin_scenes;
+    use crate::run::run_scene;
+    use crate::scene::Mode;
+
+    /// Every built-in geom-core scene parses and runs end to end in quick mode, and its
+    /// invariant figures hold.
+    #[test]
+    fn geom_core_scenes_run_quick() {
+        let root = std::env::temp_dir().join(format!("xtask-gc-scenes-{}", std::process::id()));
+        for s in builtin_scenes().unwrap().into_iter().filter(|s| s.id.starts_with("geom-core/")) {
+            let dir = root.join(&s.id);
+            let sum = run_scene(&s.id, &s.file, Mode::Quick, &dir).unwrap_or_else(|e| panic!("{}: {e}", s.id));
+            match s.id.as_str() {
+                "geom-core/subdivision" => {
+                    assert_eq!(sum.get("prolongation_max_abs_err"), Some(0.0));
+                    assert!(sum.get("galerkin_mass_max_rel_err").unwrap() < 1e-12);
+                    assert!(sum.get("laplacian_rowsum_max_rel").unwrap() < 1e-12);
+                }
+                "geom-core/mocap" => assert!(sum.get("01_01_roundtrip_max_err_m").unwrap() < 1e-6),
+                "geom-core/render" => assert!(sum.get("icosphere_silhouette_px").unwrap() > 0.0),
+                _ => {}
+            }
+        }
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+}
