@@ -3,7 +3,9 @@
 //! experiment into one report.
 
 mod bench_barnet;
+mod bench_curve_skin;
 mod bench_geom_core;
+mod bench_shells;
 mod error;
 mod inspect;
 mod out;

@@ -55,6 +55,8 @@ pub fn runners() -> Vec<Runner> {
     let mut v = Vec::new();
     crate::scenes::geom_core::register(&mut v);
     crate::scenes::barnet::register(&mut v);
+    crate::scenes::shells::register(&mut v);
+    crate::scenes::curve_skin::register(&mut v);
     v
 }
 
@@ -70,6 +72,16 @@ pub fn benches() -> Vec<Bench> {
             crate_name: "barnet",
             description: "bar-net: membrane resolution vs shape error and time per frame; Catmull-Clark level vs error and arm frame time",
             run: crate::bench_barnet::run,
+        },
+        Bench {
+            crate_name: "curve-skin",
+            description: "curve skinning: frame-table size, LBS influence count and method cost against accuracy",
+            run: crate::bench_curve_skin::run,
+        },
+        Bench {
+            crate_name: "shells",
+            description: "substeps × Newton iterations × Hessian mode on drape and wind-flag: error vs ms/frame",
+            run: crate::bench_shells::run,
         },
     ]
 }

@@ -1,0 +1,317 @@
+//! Element evaluation and fixed-pattern sparse assembly of the implicit system (shells.md §3.7,
+//! §3.8).
+//!
+//! Every element (triangle, hinge) writes its energy, local forces and local system matrix
+//! (h_eff²K_e + h_eff K_d,e − h_eff J_v,e) into its own slot of flat buffers, in parallel. Then
+//! (a) each vertex sums its element forces in a fixed order and (b) each stored matrix entry sums
+//! its contributions in a fixed order ([`FixedPattern`]). Both reductions are independent of the
+//! thread count, so the whole assembly is bitwise deterministic. The pattern never changes, so
+//! the symbolic Cholesky analysis is computed once.
+
+use crate::integrator::DofMap;
+use crate::kernels::bending::bending_eval;
+use crate::kernels::membrane::{membrane_eval, Membrane};
+use crate::kernels::psd::HessianMode;
+use crate::mesh::ShellMesh;
+use crate::wind::WindField;
+use geom_core::linalg::{Csc, FixedPattern};
+use geom_core::math::{Mat3, Pt3, Vec3};
+use geom_core::NONE;
+use rayon::prelude::*;
+
+const TRI_VALS: usize = 81;
+const HINGE_VALS: usize = 144;
+const DIAG_VALS: usize = 9;
+
+/// Inputs of one element pass.
+pub(crate) struct EvalInput<'a> {
+    pub q: &'a [Pt3],
+    pub v: &'a [Vec3],
+    pub h_eff: f64,
+    pub mode: HessianMode,
+    pub law: &'a Membrane,
+    /// (α, β_stretch, β_shear, β_bend).
+    pub damping: (f64, f64, f64, f64),
+    pub wind: Option<(&'a WindField, f64)>,
+    /// Extra diagonal shift τ (times the mass) for the regularised retry.
+    pub shift: f64,
+}
+
+/// Element pass results that are not stored in the matrix.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct EvalOutput {
+    pub skipped_hinges: u32,
+    pub collapsed_triangles: u32,
+}
+
+/// Buffers, gather lists, the fixed pattern.
+pub(crate) struct Assembler {
+    pub dofs: DofMap,
+    pattern: FixedPattern,
+    src: Vec<u32>,
+    contrib: Vec<f64>,
+    vals: Vec<f64>,
+    off_hinge: usize,
+    off_diag: usize,
+    elem_force: Vec<Vec3>,
+    tri_energy: Vec<f64>,
+    hinge_energy: Vec<f64>,
+    hinge_skipped: Vec<bool>,
+    tri_collapsed: Vec<bool>,
+    force_ptr: Vec<u32>,
+    force_idx: Vec<u32>,
+    /// Custom diagonal Jacobian blocks (−h J_v − h² J_x) per free vertex, added to the diagonal.
+    pub custom_diag: Vec<Mat3>,
+    /// Custom off-diagonal blocks: (offset of the block in a triangle's local matrix, block).
+    pub custom_offdiag: Vec<(usize, Mat3)>,
+    /// Offset of block (i, j) in the local matrix of the first triangle holding both vertices.
+    block_offset: std::collections::HashMap<(u32, u32), usize>,
+}
+
+impl Assembler {
+    pub(crate) fn new(mesh: &ShellMesh, dofs: DofMap) -> Self {
+        let nt = mesh.tris.len();
+        let nh = mesh.hinges.len();
+        let nf = dofs.n_free();
+        let off_hinge = nt * TRI_VALS;
+        let off_diag = off_hinge + nh * HINGE_VALS;
+        let mut keys: Vec<(u32, u32)> = Vec::new();
+        let mut src: Vec<u32> = Vec::new();
+        let fi = &dofs.free_index;
+        let mut push_elem = |verts: &[u32], base: usize, nloc: usize| {
+            for (a, &va) in verts.iter().enumerate() {
+                let fa = fi[va as usize];
+                if fa == NONE {
+                    continue;
+                }
+                for (b, &vb) in verts.iter().enumerate() {
+                    let fb = fi[vb as usize];
+                    if fb == NONE {
+                        continue;
+                    }
+                    for r in 0..3 {
+                        for c in 0..3 {
+                            let (row, col) = (3 * fa + r, 3 * fb + c);
+                            if row >= col {
+                                keys.push((row, col));
+                                src.push((base + (3 * a + r as usize) * nloc + 3 * b + c as usize) as u32);
+                            }
+                        }
+                    }
+                }
+            }
+        };
+        for (t, tri) in mesh.tris.iter().enumerate() {
+            push_elem(tri, t * TRI_VALS, 9);
+        }
+        for (h, hg) in mesh.hinges.iter().enumerate() {
+            push_elem(&hg.v, off_hinge + h * HINGE_VALS, 12);
+        }
+        for f in 0..nf as u32 {
+            for r in 0..3u32 {
+                for c in 0..=r {
+                    keys.push((3 * f + r, 3 * f + c));
+                    src.push((off_diag + f as usize * DIAG_VALS + (3 * r + c) as usize) as u32);
+                }
+            }
+        }
+        let pattern = FixedPattern::new(3 * nf, 3 * nf, &keys, true);
+        let mut block_offset = std::collections::HashMap::new();
+        for (t, tri) in mesh.tris.iter().enumerate() {
+            for a in 0..3 {
+                for b in 0..3 {
+                    if a != b {
+                        block_offset.entry((tri[a], tri[b])).or_insert(t * TRI_VALS + 3 * a * 9 + 3 * b);
+                    }
+                }
+            }
+        }
+        // Per-vertex force gather in element order (triangles first, then hinges).
+        let n = mesh.n_vertices();
+        let mut count = vec![0u32; n + 1];
+        for tri in &mesh.tris {
+            for &v in tri {
+                count[v as usize + 1] += 1;
+            }
+        }
+        for hg in &mesh.hinges {
+            for &v in &hg.v {
+                count[v as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let force_ptr = count.clone();
+        let mut fill = count;
+        let mut force_idx = vec![0u32; *force_ptr.last().unwrap_or(&0) as usize];
+        for (t, tri) in mesh.tris.iter().enumerate() {
+            for (k, &v) in tri.iter().enumerate() {
+                force_idx[fill[v as usize] as usize] = (3 * t + k) as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        for (h, hg) in mesh.hinges.iter().enumerate() {
+            for (k, &v) in hg.v.iter().enumerate() {
+                force_idx[fill[v as usize] as usize] = (3 * nt + 4 * h + k) as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Self {
+            contrib: vec![0.0; src.len()],
+            src,
+            pattern,
+            vals: vec![0.0; off_diag + nf * DIAG_VALS],
+            off_hinge,
+            off_diag,
+            elem_force: vec![Vec3::zeros(); 3 * nt + 4 * nh],
+            tri_energy: vec![0.0; nt],
+            hinge_energy: vec![0.0; nh],
+            hinge_skipped: vec![false; nh],
+            tri_collapsed: vec![false; nt],
+            force_ptr,
+            force_idx,
+            custom_diag: vec![Mat3::zeros(); nf],
+            custom_offdiag: Vec::new(),
+            block_offset,
+            dofs,
+        }
+    }
+
+    /// Offset of the (i, j) block (i ≠ j sharing a triangle) in the triangle buffers.
+    pub(crate) fn block_offset(&self, i: u32, j: u32) -> Option<usize> {
+        self.block_offset.get(&(i, j)).copied()
+    }
+
+    /// The assembled matrix (lower triangle) as of the last [`Assembler::assemble`].
+    pub(crate) fn matrix(&self) -> &Csc {
+        self.pattern.csc()
+    }
+
+    /// Evaluates all elements at `inp.q`/`inp.v`, writes element forces (elastic + damping +
+    /// wind) into `force` (one per vertex, overwritten), and assembles the system matrix.
+    pub(crate) fn assemble(&mut self, mesh: &ShellMesh, inp: &EvalInput, force: &mut [Vec3]) -> EvalOutput {
+        let (alpha, bs, bsh, bb) = inp.damping;
+        let h = inp.h_eff;
+        let h2 = h * h;
+        let damp_mem = (bs > 0.0 || bsh > 0.0).then_some((bs, bsh));
+        let nt = mesh.tris.len();
+        let (tri_vals, rest) = self.vals.split_at_mut(self.off_hinge);
+        let (hinge_vals, diag_vals) = rest.split_at_mut(self.off_diag - self.off_hinge);
+        let (tri_force, hinge_force) = self.elem_force.split_at_mut(3 * nt);
+        // Triangles: membrane (+ damping, + wind).
+        tri_vals
+            .par_chunks_mut(TRI_VALS)
+            .zip(tri_force.par_chunks_mut(3))
+            .zip(self.tri_energy.par_iter_mut())
+            .zip(self.tri_collapsed.par_iter_mut())
+            .enumerate()
+            .for_each(|(t, (((m, f), e), col))| {
+                let tri = mesh.tris[t];
+                let x = tri.map(|v| inp.q[v as usize]);
+                let vl = tri.map(|v| inp.v[v as usize]);
+                let o = membrane_eval(&mesh.tri_rest[t], inp.law, &x, inp.mode, damp_mem);
+                *e = o.energy;
+                *col = o.collapsed;
+                let mut mat = h2 * o.hess;
+                for a in 0..3 {
+                    f[a] = -o.grad.fixed_rows::<3>(3 * a).into_owned();
+                }
+                if let Some(d) = &o.damp {
+                    mat += h * d;
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            f[a] -= d.fixed_view::<3, 3>(3 * a, 3 * b) * vl[b];
+                        }
+                    }
+                }
+                if let Some((wf, t_wind)) = inp.wind {
+                    let (fw, jv) = wf.triangle(&x, &vl, t_wind);
+                    for a in 0..3 {
+                        f[a] += fw;
+                        for b in 0..3 {
+                            let mut blk = mat.fixed_view_mut::<3, 3>(3 * a, 3 * b);
+                            blk -= h * jv;
+                        }
+                    }
+                }
+                m.copy_from_slice(mat.transpose().as_slice()); // row-major
+            });
+        // Hinges: bending (+ damping).
+        hinge_vals
+            .par_chunks_mut(HINGE_VALS)
+            .zip(hinge_force.par_chunks_mut(4))
+            .zip(self.hinge_energy.par_iter_mut())
+            .zip(self.hinge_skipped.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, (((m, f), e), sk))| {
+                let hg = &mesh.hinges[i];
+                let x = hg.v.map(|v| inp.q[v as usize]);
+                let o = bending_eval(hg, &x, inp.mode, bb > 0.0);
+                *e = o.energy;
+                *sk = o.skipped;
+                let mut mat = h2 * o.hess;
+                for a in 0..4 {
+                    f[a] = -o.grad.fixed_rows::<3>(3 * a).into_owned();
+                }
+                if let Some(gn) = &o.gauss_newton {
+                    mat += (h * bb) * gn;
+                    let vl = hg.v.map(|v| inp.v[v as usize]);
+                    for a in 0..4 {
+                        for b in 0..4 {
+                            f[a] -= bb * (gn.fixed_view::<3, 3>(3 * a, 3 * b) * vl[b]);
+                        }
+                    }
+                }
+                m.copy_from_slice(mat.transpose().as_slice());
+            });
+        // Custom off-diagonal Jacobian blocks, in the order given (deterministic).
+        for &(off, m) in &self.custom_offdiag {
+            for r in 0..3 {
+                for c in 0..3 {
+                    tri_vals[off + r * 9 + c] += m[(r, c)];
+                }
+            }
+        }
+        // Diagonal mass blocks (1 + hα + τ)m I + custom Jacobian blocks.
+        let dofs = &self.dofs;
+        let custom = &self.custom_diag;
+        diag_vals.par_chunks_mut(DIAG_VALS).enumerate().for_each(|(fidx, d)| {
+            let v = dofs.free_vertices[fidx] as usize;
+            let m = mesh.mass[v] * (1.0 + h * alpha + inp.shift);
+            let blk = Mat3::from_diagonal_element(m) + custom[fidx];
+            d.copy_from_slice(blk.transpose().as_slice());
+        });
+        // Per-vertex force sums in fixed element order.
+        let (ptr, idx, ef) = (&self.force_ptr, &self.force_idx, &self.elem_force);
+        force.par_iter_mut().enumerate().for_each(|(v, out)| {
+            let mut s = Vec3::zeros();
+            for &k in &idx[ptr[v] as usize..ptr[v + 1] as usize] {
+                s += ef[k as usize];
+            }
+            *out = s;
+        });
+        // Matrix: gather then fixed-order sums.
+        let vals = &self.vals;
+        self.contrib.par_iter_mut().zip(self.src.par_iter()).for_each(|(c, &s)| *c = vals[s as usize]);
+        self.pattern.assemble(&self.contrib);
+        EvalOutput {
+            skipped_hinges: self.hinge_skipped.iter().filter(|&&s| s).count() as u32,
+            collapsed_triangles: self.tri_collapsed.iter().filter(|&&s| s).count() as u32,
+        }
+    }
+
+    /// Re-assembles only the diagonal blocks with a new shift τ (regularised retry, §3.8).
+    pub(crate) fn reshift(&mut self, mesh: &ShellMesh, h_eff: f64, alpha: f64, shift: f64) {
+        for fidx in 0..self.dofs.n_free() {
+            let v = self.dofs.free_vertices[fidx] as usize;
+            let m = mesh.mass[v] * (1.0 + h_eff * alpha + shift);
+            let blk = Mat3::from_diagonal_element(m) + self.custom_diag[fidx];
+            let o = self.off_diag + fidx * DIAG_VALS;
+            self.vals[o..o + DIAG_VALS].copy_from_slice(blk.transpose().as_slice());
+        }
+        let vals = &self.vals;
+        self.contrib.par_iter_mut().zip(self.src.par_iter()).for_each(|(c, &s)| *c = vals[s as usize]);
+        self.pattern.assemble(&self.contrib);
+    }
+}

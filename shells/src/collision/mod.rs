@@ -1,0 +1,594 @@
+//! Collision handling after Bridson, Fedkiw & Anderson 2002 (shells.md §3.9): a velocity filter
+//! applied after the linear solve, so the system matrix and its symbolic factorisation never
+//! change.
+//!
+//! Invariant: q_k is collision-free; [`Collider::filter`] edits the end-of-step velocities so the
+//! straight motion q_k → q_k + h v stays collision-free:
+//! 1. proximity at q_k (vertex–triangle, edge–edge closer than h_c): inelastic impulse, then a
+//!    capped repulsion, with Coulomb friction;
+//! 2. rigid obstacles (infinite mass): vertices, plus edges against thin capsules/spheres;
+//! 3. continuous detection (coplanarity cubics) with inelastic impulses that leave a small
+//!    separating speed, up to `ccd_passes` passes;
+//! 4. rigid impact zones for what remains, and as a last resort freezing the offending vertices
+//!    at q_k (collision-free by the invariant), reported in the statistics.
+//!
+//! Impulses of one pass are accumulated (Jacobi) in the sorted pair order and each pair's
+//! impulse is scaled by 1/(largest number of pairs of any of its vertices), which keeps every
+//! impulse equal and opposite, hence linear momentum is conserved.
+
+pub mod broad;
+pub mod ccd;
+pub mod geometry;
+pub mod obstacles;
+
+use crate::effects::{CollisionSettings, Effects, Obstacle};
+use crate::integrator::StepStats;
+use crate::mesh::ShellMesh;
+use broad::{candidate_pairs, Bx};
+use geom_core::graph::UnionFind;
+use geom_core::math::{Mat3, Pt3, Vec3};
+use geometry::{closest_point_triangle, closest_points_segments, safe_normal};
+use obstacles::PlacedObstacle;
+use rayon::prelude::*;
+
+/// A contact stencil: up to four vertices with weights c_i (relative velocity Σc_i v_i) and a
+/// unit normal.
+#[derive(Clone, Copy, Debug)]
+struct Stencil {
+    v: [u32; 4],
+    c: [f64; 4],
+    n: Vec3,
+}
+
+impl Stencil {
+    fn rel(&self, vel: &[Vec3]) -> Vec3 {
+        (0..4).map(|k| self.c[k] * vel[self.v[k] as usize]).sum()
+    }
+    fn denom(&self, im: &[f64]) -> f64 {
+        (0..4).map(|k| self.c[k] * self.c[k] * im[self.v[k] as usize]).sum()
+    }
+}
+
+/// One requested velocity change: raise v_N by `dn` (≥ 0) and apply friction μ.
+struct Request {
+    s: Stencil,
+    dn: f64,
+    mu: f64,
+}
+
+/// The collision pipeline of one simulation (built only when `effects.collision` is set).
+pub(crate) struct Collider {
+    tris: Vec<[u32; 3]>,
+    edges: Vec<[u32; 2]>,
+    mass: Vec<f64>,
+    h_c: f64,
+    mu: f64,
+    k_rep: f64,
+    settings: CollisionSettings,
+    delta_ccd: f64,
+    self_collision: bool,
+    obstacles: Vec<Obstacle>,
+    thin: f64,
+    cell: f64,
+}
+
+impl Collider {
+    pub(crate) fn new(mesh: &ShellMesh, effects: &Effects, cs: &CollisionSettings, membrane_stiffness: f64) -> Self {
+        let mean_edge = mesh.mean_edge_length();
+        let h_c = if cs.thickness > 0.0 { cs.thickness } else { (0.1 * mean_edge).clamp(1e-3, 1e-2) };
+        let l = geom_core::mesh::bbox_of(&mesh.rest).map(|(a, b)| (b - a).norm()).unwrap_or(1.0);
+        Self {
+            tris: mesh.tris.clone(),
+            edges: mesh.edges.clone(),
+            mass: mesh.mass.clone(),
+            h_c,
+            mu: cs.friction,
+            k_rep: cs.repulsion_stiffness.unwrap_or(membrane_stiffness),
+            settings: cs.clone(),
+            delta_ccd: 1e-6 * l,
+            self_collision: effects.self_collision,
+            obstacles: effects.obstacles.clone(),
+            thin: 2.0 * mean_edge,
+            cell: (2.0 * mean_edge).max(4.0 * h_c).max(1e-6),
+        }
+    }
+
+    /// Filters the end-of-step velocities `v` (motion q → q + h v) in place; `im` holds inverse
+    /// masses (0 for pinned/kinematic vertices, whose velocities are never changed).
+    pub(crate) fn filter(&mut self, q: &[Pt3], v: &mut [Vec3], h: f64, t_next: f64, im: &[f64], st: &mut StepStats) {
+        let n = q.len();
+        if n == 0 {
+            return;
+        }
+        if self.self_collision {
+            self.proximity(q, v, h, im, st);
+        }
+        self.obstacle_pass(q, v, h, t_next, im, st);
+        if !self.self_collision {
+            return;
+        }
+        let mut remaining = Vec::new();
+        if self.settings.ccd {
+            for _ in 0..self.settings.ccd_passes.max(1) {
+                let hits = self.ccd_hits(q, v, h);
+                if hits.is_empty() {
+                    return;
+                }
+                st.n_ccd += hits.len() as u32;
+                let target = self.settings.separation_speed_frac * self.h_c / h;
+                let reqs: Vec<Request> = hits
+                    .into_iter()
+                    .filter_map(|s| {
+                        let vn = s.rel(v).dot(&s.n);
+                        (vn < target).then_some(Request { s, dn: target - vn, mu: 0.0 })
+                    })
+                    .collect();
+                apply(&reqs, v, im, n);
+            }
+            remaining = self.ccd_hits(q, v, h);
+        }
+        if !remaining.is_empty() {
+            self.impact_zones(q, v, h, im, remaining, st);
+        }
+    }
+
+    /// Swept, inflated boxes of vertices, triangles and edges.
+    fn boxes(&self, q: &[Pt3], v: &[Vec3], h: f64, margin: f64) -> (Vec<Bx>, Vec<Bx>, Vec<Bx>) {
+        let end: Vec<Pt3> = q.iter().zip(v).map(|(p, w)| p + h * w).collect();
+        let vb: Vec<Bx> = (0..q.len()).into_par_iter().map(|i| Bx::of(&[q[i], end[i]], margin)).collect();
+        let tb: Vec<Bx> = self
+            .tris
+            .par_iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| i as usize);
+                Bx::of(&[q[a], q[b], q[c], end[a], end[b], end[c]], margin)
+            })
+            .collect();
+        let eb: Vec<Bx> = self
+            .edges
+            .par_iter()
+            .map(|e| {
+                let [a, b] = e.map(|i| i as usize);
+                Bx::of(&[q[a], q[b], end[a], end[b]], margin)
+            })
+            .collect();
+        (vb, tb, eb)
+    }
+
+    /// Step 1: proximity at q with inelastic + repulsion impulses and friction.
+    fn proximity(&self, q: &[Pt3], v: &mut [Vec3], h: f64, im: &[f64], st: &mut StepStats) {
+        let hc = self.h_c;
+        let zero = vec![Vec3::zeros(); q.len()];
+        let (vb, tb, eb) = self.boxes(q, &zero, h, hc);
+        let (vt, ee) = candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb, self.cell);
+        let mut stencils: Vec<(Stencil, f64)> = Vec::new();
+        for &(p, t) in &vt {
+            let tri = self.tris[t as usize];
+            let x = tri.map(|i| q[i as usize]);
+            let (c, w) = closest_point_triangle(&q[p as usize], &x);
+            let d = (q[p as usize] - c).norm();
+            if d < hc {
+                let tn = (x[1] - x[0]).cross(&(x[2] - x[0]));
+                let nrm = if d > 1e-12 * hc {
+                    (q[p as usize] - c) / d
+                } else {
+                    // Coincident: the triangle normal, on the vertex's side of motion.
+                    let n0 = safe_normal(&(x[1] - x[0]), &(x[2] - x[0]));
+                    if tn.dot(&(v[p as usize])) > 0.0 {
+                        -n0
+                    } else {
+                        n0
+                    }
+                };
+                stencils.push((Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm }, d));
+            }
+        }
+        for &(e, f) in &ee {
+            let (a, b) = (self.edges[e as usize], self.edges[f as usize]);
+            let (s, u, pa, pb) =
+                closest_points_segments(&q[a[0] as usize], &q[a[1] as usize], &q[b[0] as usize], &q[b[1] as usize]);
+            let d = (pa - pb).norm();
+            if d < hc {
+                let nrm = if d > 1e-12 * hc {
+                    (pa - pb) / d
+                } else {
+                    safe_normal(&(q[a[1] as usize] - q[a[0] as usize]), &(q[b[1] as usize] - q[b[0] as usize]))
+                };
+                stencils.push((Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm }, d));
+            }
+        }
+        st.n_proximity += stencils.len() as u32;
+        let fsep = self.settings.separation_speed_frac;
+        let reqs: Vec<Request> = stencils
+            .into_iter()
+            .filter_map(|(s, d)| {
+                let den = s.denom(im);
+                if den <= 0.0 {
+                    return None;
+                }
+                let vn = s.rel(v).dot(&s.n);
+                let mut dn = if vn < 0.0 { -vn } else { 0.0 };
+                let vn1 = vn + dn;
+                let gap = hc - d;
+                let want = fsep * gap / h;
+                if vn1 < want {
+                    let meff = 1.0 / den;
+                    dn += (h * self.k_rep * gap / meff).min(want - vn1);
+                }
+                (dn > 0.0).then_some(Request { s, dn, mu: self.mu })
+            })
+            .collect();
+        apply(&reqs, v, im, q.len());
+    }
+
+    /// Step 2 (and final clamp): obstacles, infinite mass.
+    fn obstacle_pass(&self, q: &[Pt3], v: &mut [Vec3], h: f64, t_next: f64, im: &[f64], st: &mut StepStats) {
+        if self.obstacles.is_empty() {
+            return;
+        }
+        let hc = self.h_c;
+        let fsep = self.settings.separation_speed_frac;
+        for o in &self.obstacles {
+            let po = PlacedObstacle::new(o, t_next, h);
+            // Vertices (each independent: obstacle impulses go entirely to the cloth).
+            let hits: Vec<(usize, Vec3)> = (0..q.len())
+                .into_par_iter()
+                .filter_map(|i| {
+                    if im[i] == 0.0 {
+                        return None;
+                    }
+                    let p0 = po.query(&q[i]);
+                    let pe = po.query(&(q[i] + h * v[i]));
+                    if p0.distance >= hc && pe.distance >= hc {
+                        return None;
+                    }
+                    let nrm = if p0.distance < hc { p0.normal } else { pe.normal };
+                    let vo = po.velocity_at(&q[i], h);
+                    let rel = v[i] - vo;
+                    let vn = rel.dot(&nrm);
+                    // Below h_c: no approach plus a small separation; farther: stop at 0.9 h_c.
+                    let vn_min = if p0.distance < hc {
+                        (fsep * (hc - p0.distance) / h).max(0.0)
+                    } else {
+                        (0.9 * hc - p0.distance) / h
+                    };
+                    let vn_min = vn_min.max((hc * (1.0 - fsep) - pe.distance.min(p0.distance)).min(0.0) / h);
+                    if vn >= vn_min {
+                        return None;
+                    }
+                    let dn = vn_min - vn;
+                    let vt = rel - vn * nrm;
+                    let tl = vt.norm();
+                    let red = (o.friction * dn).min(tl);
+                    let new_rel = rel + dn * nrm - if tl > 0.0 { red * vt / tl } else { Vec3::zeros() };
+                    Some((i, vo + new_rel))
+                })
+                .collect();
+            st.n_proximity += hits.len() as u32;
+            for (i, w) in hits {
+                v[i] = w;
+            }
+            // Edges against thin round shapes (a branch between two vertices).
+            if let (true, Some((a, b, r))) = (po.is_thin(self.thin), po.capsule_axis()) {
+                let mut reqs: Vec<(usize, usize, f64, Vec3, f64)> = Vec::new();
+                for e in &self.edges {
+                    let (i, j) = (e[0] as usize, e[1] as usize);
+                    for (pi, pj) in [(q[i], q[j]), (q[i] + h * v[i], q[j] + h * v[j])] {
+                        let (s, _, pe, pa) = closest_points_segments(&pi, &pj, &a, &b);
+                        let d = (pe - pa).norm() - r;
+                        if d < hc && s > 0.0 && s < 1.0 {
+                            let nrm = if (pe - pa).norm() > 0.0 { (pe - pa).normalize() } else { Vec3::y() };
+                            let rel = (1.0 - s) * v[i] + s * v[j] - po.velocity_at(&pe, h);
+                            let vn = rel.dot(&nrm);
+                            let d0 = {
+                                let (_, _, p0, a0) = closest_points_segments(&q[i], &q[j], &a, &b);
+                                (p0 - a0).norm() - r
+                            };
+                            let vn_min = if d0 < hc { (fsep * (hc - d0) / h).max(0.0) } else { (0.9 * hc - d0) / h };
+                            if vn < vn_min {
+                                reqs.push((i, j, s, nrm, vn_min - vn));
+                            }
+                            break;
+                        }
+                    }
+                }
+                for (i, j, s, nrm, dn) in reqs {
+                    let den = (1.0 - s) * (1.0 - s) * im[i] + s * s * im[j];
+                    if den > 0.0 {
+                        let jn = dn / den;
+                        v[i] += (1.0 - s) * jn * im[i] * nrm;
+                        v[j] += s * jn * im[j] * nrm;
+                    }
+                }
+            }
+        }
+    }
+
+    /// All CCD hits of the motion q → q + h v, as stencils with separating normals.
+    fn ccd_hits(&self, q: &[Pt3], v: &[Vec3], h: f64) -> Vec<Stencil> {
+        let delta = self.delta_ccd;
+        let (vb, tb, eb) = self.boxes(q, v, h, delta);
+        let (vt, ee) = candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb, self.cell);
+        let dv = |i: u32| h * v[i as usize];
+        let mut hits: Vec<Stencil> = vt
+            .par_iter()
+            .filter_map(|&(p, t)| {
+                let tri = self.tris[t as usize];
+                let x = tri.map(|i| q[i as usize]);
+                let d = tri.map(dv);
+                let (tc, w) = ccd::vertex_triangle(&q[p as usize], &dv(p), &x, &d, delta)?;
+                let xt: [Pt3; 3] = std::array::from_fn(|k| x[k] + tc * d[k]);
+                let mut nrm = safe_normal(&(xt[1] - xt[0]), &(xt[2] - xt[0]));
+                // Orient from the triangle toward the vertex's starting side.
+                let (c0, _) = closest_point_triangle(&q[p as usize], &x);
+                let side = (q[p as usize] - c0).dot(&nrm);
+                let rel = dv(p) - (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]);
+                if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
+                    nrm = -nrm;
+                }
+                Some(Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm })
+            })
+            .collect();
+        let ee_hits: Vec<Stencil> = ee
+            .par_iter()
+            .filter_map(|&(e, f)| {
+                let (a, b) = (self.edges[e as usize], self.edges[f as usize]);
+                let xa = [q[a[0] as usize], q[a[1] as usize]];
+                let xb = [q[b[0] as usize], q[b[1] as usize]];
+                let da = [dv(a[0]), dv(a[1])];
+                let db = [dv(b[0]), dv(b[1])];
+                let (tc, s, u) = ccd::edge_edge(&xa, &da, &xb, &db, delta)?;
+                let ya: [Pt3; 2] = std::array::from_fn(|k| xa[k] + tc * da[k]);
+                let yb: [Pt3; 2] = std::array::from_fn(|k| xb[k] + tc * db[k]);
+                let mut nrm = safe_normal(&(ya[1] - ya[0]), &(yb[1] - yb[0]));
+                let (_, _, p0, q0) = closest_points_segments(&xa[0], &xa[1], &xb[0], &xb[1]);
+                let side = (p0 - q0).dot(&nrm);
+                let rel = (1.0 - s) * da[0] + s * da[1] - (1.0 - u) * db[0] - u * db[1];
+                if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
+                    nrm = -nrm;
+                }
+                Some(Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm })
+            })
+            .collect();
+        hits.extend(ee_hits);
+        hits
+    }
+
+    /// Step 4: rigid impact zones, then freezing as the failsafe.
+    fn impact_zones(&self, q: &[Pt3], v: &mut [Vec3], h: f64, im: &[f64], mut hits: Vec<Stencil>, st: &mut StepStats) {
+        let n = q.len();
+        let mut uf = UnionFind::new(n);
+        let mut in_zone = vec![false; n];
+        for _ in 0..self.settings.impact_zone_iters.max(1) {
+            for s in &hits {
+                for k in 1..4 {
+                    uf.union(s.v[0], s.v[k]);
+                }
+                for &x in &s.v {
+                    in_zone[x as usize] = true;
+                }
+            }
+            self.rigidify(q, v, im, &mut uf, &in_zone, st);
+            hits = self.ccd_hits(q, v, h);
+            if hits.is_empty() {
+                return;
+            }
+        }
+        // Failsafe: freeze offending free vertices at q (v = 0) until nothing collides.
+        let mut frozen = vec![false; n];
+        loop {
+            let mut changed = false;
+            for s in &hits {
+                for &x in &s.v {
+                    let x = x as usize;
+                    if im[x] > 0.0 && !frozen[x] {
+                        frozen[x] = true;
+                        v[x] = Vec3::zeros();
+                        changed = true;
+                    }
+                }
+            }
+            // Also freeze whole zones that contain a frozen vertex.
+            if !changed {
+                break;
+            }
+            hits = self.ccd_hits(q, v, h);
+            if hits.is_empty() {
+                break;
+            }
+        }
+        st.n_frozen += frozen.iter().filter(|&&f| f).count() as u32;
+    }
+
+    /// Sets every zone's velocities to its rigid motion (constrained vertices impose theirs).
+    fn rigidify(
+        &self,
+        q: &[Pt3],
+        v: &mut [Vec3],
+        im: &[f64],
+        uf: &mut UnionFind,
+        in_zone: &[bool],
+        st: &mut StepStats,
+    ) {
+        let n = q.len();
+        let mut members: std::collections::BTreeMap<u32, Vec<usize>> = std::collections::BTreeMap::new();
+        for i in 0..n {
+            if in_zone[i] {
+                members.entry(uf.find(i as u32)).or_default().push(i);
+            }
+        }
+        st.n_impact_zones = st.n_impact_zones.max(members.len() as u32);
+        for zone in members.values() {
+            st.max_zone_size = st.max_zone_size.max(zone.len() as u32);
+            let constrained: Vec<usize> = zone.iter().copied().filter(|&i| im[i] == 0.0).collect();
+            if !constrained.is_empty() {
+                // Move with the prescribed velocity (mean if they disagree).
+                let vm: Vec3 = constrained.iter().map(|&i| v[i]).sum::<Vec3>() / constrained.len() as f64;
+                for &i in zone {
+                    if im[i] > 0.0 {
+                        v[i] = vm;
+                    }
+                }
+                continue;
+            }
+            let m: f64 = zone.iter().map(|&i| self.mass[i]).sum();
+            if !(m > 0.0) {
+                continue;
+            }
+            let xc: Vec3 = zone.iter().map(|&i| self.mass[i] * q[i].coords).sum::<Vec3>() / m;
+            let vc: Vec3 = zone.iter().map(|&i| self.mass[i] * v[i]).sum::<Vec3>() / m;
+            let mut l = Vec3::zeros();
+            let mut inertia = Mat3::zeros();
+            for &i in zone {
+                let r = q[i].coords - xc;
+                l += self.mass[i] * r.cross(&(v[i] - vc));
+                inertia += self.mass[i] * (r.norm_squared() * Mat3::identity() - r * r.transpose());
+            }
+            let omega = pinv3(&inertia) * l;
+            for &i in zone {
+                v[i] = vc + omega.cross(&(q[i].coords - xc));
+            }
+        }
+    }
+}
+
+/// Pseudo-inverse of a symmetric PSD 3×3 matrix (eigenvalues below 1e-12·max dropped).
+fn pinv3(m: &Mat3) -> Mat3 {
+    let e = nalgebra::SymmetricEigen::new(*m);
+    let mx = e.eigenvalues.amax();
+    let mut out = Mat3::zeros();
+    for k in 0..3 {
+        let l = e.eigenvalues[k];
+        if l > 1e-12 * mx && l > 0.0 {
+            let c = e.eigenvectors.column(k);
+            out += c * c.transpose() / l;
+        }
+    }
+    out
+}
+
+/// Applies a batch of requests together (Jacobi): each pair's impulse scaled by 1/(largest
+/// number of requests touching any of its vertices).
+fn apply(reqs: &[Request], v: &mut [Vec3], im: &[f64], n: usize) {
+    if reqs.is_empty() {
+        return;
+    }
+    let mut count = vec![0u32; n];
+    for r in reqs {
+        for k in 0..4 {
+            if r.s.c[k] != 0.0 {
+                count[r.s.v[k] as usize] += 1;
+            }
+        }
+    }
+    let mut dv = vec![Vec3::zeros(); n];
+    for r in reqs {
+        let den = r.s.denom(im);
+        if !(den > 0.0) {
+            continue;
+        }
+        let scale = 1.0
+            / (0..4).filter(|&k| r.s.c[k] != 0.0).map(|k| count[r.s.v[k] as usize]).max().unwrap_or(1).max(1) as f64;
+        let mut imp = (r.dn / den) * r.s.n;
+        if r.mu > 0.0 {
+            let rel = r.s.rel(v);
+            let vt = rel - rel.dot(&r.s.n) * r.s.n;
+            let tl = vt.norm();
+            if tl > 0.0 {
+                imp -= ((r.mu * r.dn).min(tl) / den) * (vt / tl);
+            }
+        }
+        for k in 0..4 {
+            let i = r.s.v[k] as usize;
+            dv[i] += scale * r.s.c[k] * im[i] * imp;
+        }
+    }
+    for (vi, d) in v.iter_mut().zip(&dv) {
+        *vi += d;
+    }
+}
+
+/// Number of intersecting pairs of non-adjacent triangles (shared vertex ⇒ adjacent), with a
+/// floating-point Möller-style test; used for the `max_intersections` figure.
+pub fn count_self_intersections(q: &[Pt3], tris: &[[u32; 3]]) -> usize {
+    if tris.is_empty() {
+        return 0;
+    }
+    let boxes: Vec<Bx> = tris.iter().map(|t| Bx::of(&t.map(|i| q[i as usize]), 0.0)).collect();
+    let mean = boxes.iter().map(|b| (b.hi - b.lo).norm()).sum::<f64>() / boxes.len() as f64;
+    let mut g = broad::Grid::new(mean.max(1e-9));
+    for (i, b) in boxes.iter().enumerate() {
+        g.insert(i as u32, b);
+    }
+    let mut pairs = Vec::new();
+    for (i, b) in boxes.iter().enumerate() {
+        g.query(b, |j| {
+            let j = j as usize;
+            if j > i && b.overlaps(&boxes[j]) && !tris[i].iter().any(|v| tris[j].contains(v)) {
+                pairs.push((i, j));
+            }
+        });
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
+        .par_iter()
+        .filter(|&&(i, j)| {
+            let a = tris[i].map(|k| q[k as usize]);
+            let b = tris[j].map(|k| q[k as usize]);
+            tri_tri_intersect(&a, &b)
+        })
+        .count()
+}
+
+/// Triangle–triangle intersection (segment–triangle crossing tests in both directions); touching
+/// configurations within round-off may go either way.
+pub fn tri_tri_intersect(a: &[Pt3; 3], b: &[Pt3; 3]) -> bool {
+    (0..3).any(|k| seg_tri(&a[k], &a[(k + 1) % 3], b)) || (0..3).any(|k| seg_tri(&b[k], &b[(k + 1) % 3], a))
+}
+
+fn seg_tri(p: &Pt3, q: &Pt3, t: &[Pt3; 3]) -> bool {
+    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
+    let dp = n.dot(&(p - t[0]));
+    let dq = n.dot(&(q - t[0]));
+    if (dp > 0.0 && dq > 0.0) || (dp < 0.0 && dq < 0.0) || dp == dq {
+        return false;
+    }
+    let s = dp / (dp - dq);
+    let x = p + s * (q - p);
+    let e = |i: usize| (t[(i + 1) % 3] - t[i]).cross(&(x - t[i])).dot(&n);
+    let (e0, e1, e2) = (e(0), e(1), e(2));
+    (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tri_tri_basic() {
+        let a = [Pt3::new(0.0, 0.0, 0.0), Pt3::new(1.0, 0.0, 0.0), Pt3::new(0.0, 1.0, 0.0)];
+        let b = [Pt3::new(0.2, 0.2, -1.0), Pt3::new(0.2, 0.2, 1.0), Pt3::new(0.3, 0.5, 0.0)];
+        assert!(tri_tri_intersect(&a, &b));
+        let c = b.map(|p| p + Vec3::new(5.0, 0.0, 0.0));
+        assert!(!tri_tri_intersect(&a, &c));
+        let d = a.map(|p| p + Vec3::new(0.0, 0.0, 0.1));
+        assert!(!tri_tri_intersect(&a, &d));
+    }
+
+    /// Equal-and-opposite impulses: Jacobi application conserves momentum.
+    #[test]
+    fn impulses_conserve_momentum() {
+        let mut v = vec![Vec3::new(0.0, 0.0, -1.0), Vec3::zeros(), Vec3::zeros(), Vec3::new(0.0, 0.0, 0.5), Vec3::x()];
+        let m = [1.0, 2.0, 0.5, 1.5, 1.0];
+        let im: Vec<f64> = m.iter().map(|x| 1.0 / x).collect();
+        let p0: Vec3 = v.iter().zip(&m).map(|(a, b)| *b * a).sum();
+        let reqs = vec![
+            Request { s: Stencil { v: [0, 1, 2, 3], c: [1.0, -0.2, -0.3, -0.5], n: Vec3::z() }, dn: 1.3, mu: 0.3 },
+            Request { s: Stencil { v: [4, 1, 0, 3], c: [0.4, 0.6, -0.5, -0.5], n: Vec3::y() }, dn: 0.7, mu: 0.5 },
+        ];
+        apply(&reqs, &mut v, &im, 5);
+        let p1: Vec3 = v.iter().zip(&m).map(|(a, b)| *b * a).sum();
+        assert!((p1 - p0).norm() < 1e-14);
+    }
+}
