@@ -1,0 +1,1 @@
+//! Motion graphs: synthesis by randomized search over a hierarchy of motion graphs (Arikan and Forsyth 2002).
