@@ -8,36 +8,30 @@
 //! `(x, R cos θ_k, R sin θ_k)`. +Y is the front (the biceps side, towards which the elbow
 //! flexes), −Y the back (triceps). Faces `[v(r,k), v(r,k+1), v(r+1,k+1), v(r+1,k)]`.
 //!
-//! The tube is built here rather than with `geom_core::procedural::tube` (not available when
-//! this crate was written); it follows that function's vertex numbering `r · around + k`.
+//! The tube is `geom_core::procedural::tube` (vertex numbering `r · around + k`) with the
+//! vertices offset by half a step ([`open_tube`]).
 
 use crate::error::{BarNetError, Result};
-use geom_core::graph::Ragged;
-use geom_core::math::Pt3;
+use geom_core::math::{Pt3, Vec3};
 use geom_core::mesh::PolyMesh;
+use geom_core::procedural::{tube, Caps, TubeSpec};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::TAU;
 
 /// An open quad tube along +X from the origin: `around` vertices per ring, `along` quad rows,
-/// radius `radius`, length `length` (m).
-pub fn open_tube(around: u32, along: u32, radius: f64, length: f64) -> PolyMesh {
-    let (na, nr) = (around as usize, along as usize + 1);
-    let mut positions = Vec::with_capacity(na * nr);
-    for r in 0..nr {
-        let x = length * r as f64 / along as f64;
-        for k in 0..na {
-            let th = TAU * (k as f64 + 0.5) / na as f64;
-            positions.push(Pt3::new(x, radius * th.cos(), radius * th.sin()));
-        }
+/// radius `radius`, length `length` (m). Topology and numbering are those of
+/// `geom_core::procedural::tube` (open); the vertices are the odd columns of the tube with
+/// `2·around` vertices per ring, i.e. at `θ_k = 2π (2k + 1) / (2·around)` — exactly (bit for bit)
+/// the half-step angles `2π (k + ½) / around` of the module docs. No UVs. Errors: those of `tube`
+/// (non-positive radius or length, `around` < 3, `along` < 1).
+pub fn open_tube(around: u32, along: u32, radius: f64, length: f64) -> Result<PolyMesh> {
+    let spec = TubeSpec { radius, length, around, along, start: Pt3::origin(), axis: Vec3::x(), caps: Caps::Open };
+    let mut m = tube(&spec)?;
+    let fine = tube(&TubeSpec { around: 2 * around, ..spec })?;
+    for (i, p) in m.positions.iter_mut().enumerate() {
+        *p = fine.positions[2 * i + 1];
     }
-    let v = |r: usize, k: usize| (r * na + k % na) as u32;
-    let mut faces = Ragged::new();
-    for r in 0..nr - 1 {
-        for k in 0..na {
-            faces.push_row(&[v(r, k), v(r, k + 1), v(r + 1, k + 1), v(r + 1, k)]);
-        }
-    }
-    PolyMesh { positions, faces, uv: None }
+    m.uv = None;
+    Ok(m)
 }
 
 /// Parameters of the procedural arm (spec §2.3 `ProceduralArm`).
@@ -90,7 +84,7 @@ impl Arm {
         let len = spec.upper_len + spec.fore_len;
         Ok(Self {
             spec: spec.clone(),
-            mesh: open_tube(spec.around, spec.along, spec.radius, len),
+            mesh: open_tube(spec.around, spec.along, spec.radius, len)?,
             joint_names: vec!["shoulder".into(), "elbow".into(), "wrist".into()],
             joints: vec![Pt3::origin(), Pt3::new(spec.upper_len, 0.0, 0.0), Pt3::new(len, 0.0, 0.0)],
         })
@@ -167,6 +161,22 @@ impl Arm {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn open_tube_is_the_half_step_layout_exactly() {
+        // Bit-for-bit (x, R cos θ_k, R sin θ_k) with θ_k = 2π(k + ½)/around, x = L·r/along.
+        let (n, m, r, l) = (8u32, 22u32, 0.045, 0.57);
+        let t = open_tube(n, m, r, l).unwrap();
+        for ring in 0..=m as usize {
+            for k in 0..n as usize {
+                let th = std::f64::consts::TAU * (k as f64 + 0.5) / n as f64;
+                let x = l * ring as f64 / m as f64;
+                assert_eq!(t.positions[ring * n as usize + k], Pt3::new(x, r * th.cos(), r * th.sin()));
+            }
+        }
+        assert_eq!(t.faces.row(0), &[0, 1, n + 1, n]);
+        assert!(t.uv.is_none());
+    }
 
     #[test]
     fn default_arm_matches_the_paper_layout() {

@@ -62,17 +62,23 @@ pub fn loop_subdivision(m: &PolyMesh, levels: u32) -> Result<(PolyMesh, Csr)> {
     subdivide(m, Scheme::Loop, levels)
 }
 
+/// Row `i` of `S · p`, accumulated in f64 in the row's column order.
+fn row_times(s: &Csr, p: &[Pt3], i: usize) -> [f64; 3] {
+    let (c, w) = s.row(i);
+    let mut acc = [0.0f64; 3];
+    for (&j, &wj) in c.iter().zip(w) {
+        let q = &p[j as usize];
+        acc[0] += wj * q.x;
+        acc[1] += wj * q.y;
+        acc[2] += wj * q.z;
+    }
+    acc
+}
+
 /// `out = S · p` (f64).
 pub fn apply(s: &Csr, p: &[Pt3], out: &mut [Pt3]) {
     for (i, o) in out.iter_mut().enumerate().take(s.nrows) {
-        let (c, w) = s.row(i);
-        let mut acc = [0.0f64; 3];
-        for (&j, &wj) in c.iter().zip(w) {
-            let q = &p[j as usize];
-            acc[0] += wj * q.x;
-            acc[1] += wj * q.y;
-            acc[2] += wj * q.z;
-        }
+        let acc = row_times(s, p, i);
         *o = Pt3::new(acc[0], acc[1], acc[2]);
     }
 }
@@ -81,14 +87,7 @@ pub fn apply(s: &Csr, p: &[Pt3], out: &mut [Pt3]) {
 /// when `parallel` (bitwise identical to serial: each row is computed by one thread in order).
 pub fn apply_f32(s: &Csr, p: &[Pt3], out: &mut [[f32; 3]], parallel: bool) {
     let row = |i: usize| -> [f32; 3] {
-        let (c, w) = s.row(i);
-        let mut acc = [0.0f64; 3];
-        for (&j, &wj) in c.iter().zip(w) {
-            let q = &p[j as usize];
-            acc[0] += wj * q.x;
-            acc[1] += wj * q.y;
-            acc[2] += wj * q.z;
-        }
+        let acc = row_times(s, p, i);
         [acc[0] as f32, acc[1] as f32, acc[2] as f32]
     };
     if parallel {
@@ -285,7 +284,7 @@ mod tests {
     /// Spec 7.3 c: rows sum to 1; affine functions reproduced; 2816 faces / 2848 vertices.
     #[test]
     fn catmull_clark_arm_counts_and_affine() {
-        let m = open_tube(8, 22, 0.045, 0.57);
+        let m = open_tube(8, 22, 0.045, 0.57).unwrap();
         let (fine, s) = catmull_clark(&m, 2).unwrap();
         assert_eq!(fine.faces.len(), 2816);
         assert_eq!(fine.positions.len(), 2848);
@@ -323,7 +322,7 @@ mod tests {
 
     #[test]
     fn parallel_apply_is_bitwise_serial() {
-        let m = open_tube(8, 22, 0.045, 0.57);
+        let m = open_tube(8, 22, 0.045, 0.57).unwrap();
         let (_, s) = catmull_clark(&m, 2).unwrap();
         let mut a = vec![[0f32; 3]; s.nrows];
         let mut b = a.clone();

@@ -2,13 +2,13 @@
 //! bar-net (bars = edges), the Catmull–Clark operator (edge and face points) and the capped
 //! volume (boundary loops).
 //!
-//! Should move to geom-core (`PolyMesh::edges`, `edge_faces`, boundary loops are listed in
-//! GEOM-CORE.md §3.4 but were not available when this crate was written).
+//! Edges, edge faces and vertex faces come from `geom_core::mesh::PolyMesh`, boundary loops
+//! from `geom_core::mesh::Topology` on the fan triangulation; this type adds the face → edge
+//! and vertex → edge maps the bar-net and Catmull–Clark need.
 
 use crate::error::{BarNetError, Result};
 use geom_core::graph::Ragged;
-use geom_core::mesh::PolyMesh;
-use std::collections::HashMap;
+use geom_core::mesh::{PolyMesh, Topology};
 
 /// Edge connectivity of a polygon mesh.
 #[derive(Clone, Debug)]
@@ -29,11 +29,10 @@ pub struct PolyTopo {
 
 impl PolyTopo {
     /// Builds the connectivity. Errors: a face with fewer than 3 corners or an out-of-range
-    /// index (`InvalidParameter` / `NodeOutOfRange`), or a face repeating a vertex.
+    /// index (`InvalidParameter` / `NodeOutOfRange`), or a face repeating a vertex. Edges, edge
+    /// faces and vertex faces are geom-core's (`PolyMesh::edges`, `edge_faces`, `vertex_faces`).
     pub fn new(m: &PolyMesh) -> Result<Self> {
         let n = m.positions.len();
-        let mut key: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut edges: Vec<[u32; 2]> = Vec::new();
         for (f, row) in m.faces.rows().enumerate() {
             if row.len() < 3 {
                 return Err(BarNetError::InvalidParameter(format!("face {f} has {} corners (< 3)", row.len())));
@@ -48,44 +47,29 @@ impl PolyTopo {
                 if a == b {
                     return Err(BarNetError::InvalidParameter(format!("face {f} repeats vertex {a}")));
                 }
-                let k = (a.min(b), a.max(b));
-                if let std::collections::hash_map::Entry::Vacant(e) = key.entry(k) {
-                    e.insert(0);
-                    edges.push([k.0, k.1]);
-                }
             }
         }
-        edges.sort_unstable();
-        for (i, e) in edges.iter().enumerate() {
-            key.insert((e[0], e[1]), i as u32);
-        }
-        let mut ef_pairs = Vec::new();
+        let edges = m.edges();
+        let edge_faces = m.edge_faces();
         let mut face_edges = Ragged::new();
         let mut row_e = Vec::new();
-        for (f, row) in m.faces.rows().enumerate() {
+        for row in m.faces.rows() {
             row_e.clear();
             for (i, &a) in row.iter().enumerate() {
                 let b = row[(i + 1) % row.len()];
-                let e = key[&(a.min(b), a.max(b))];
+                // Every face edge is in `edges` (geom-core lists them all, sorted).
+                let e = edges.binary_search(&[a.min(b), a.max(b)]).expect("face edge listed") as u32;
                 row_e.push(e);
-                ef_pairs.push((e, f as u32));
             }
             face_edges.push_row(&row_e);
         }
-        let edge_faces = Ragged::from_pairs(edges.len(), &ef_pairs);
         let mut ve = Vec::with_capacity(2 * edges.len());
         for (i, e) in edges.iter().enumerate() {
             ve.push((e[0], i as u32));
             ve.push((e[1], i as u32));
         }
         let vertex_edges = Ragged::from_pairs(n, &ve);
-        let mut vf = Vec::new();
-        for (f, row) in m.faces.rows().enumerate() {
-            for &v in row {
-                vf.push((v, f as u32));
-            }
-        }
-        let vertex_faces = Ragged::from_pairs(n, &vf);
+        let vertex_faces = m.vertex_faces();
         Ok(Self { n_vertices: n, edges, edge_faces, face_edges, vertex_edges, vertex_faces })
     }
 
@@ -94,43 +78,33 @@ impl PolyTopo {
         self.edge_faces.row(e).len() == 1
     }
 
+    /// The fan triangulation of `m` and its geom-core [`Topology`] (manifold, consistently
+    /// oriented). Errors: those of `Topology::new` (non-manifold edge or vertex, inconsistent
+    /// orientation).
+    pub fn triangle_topology(m: &PolyMesh) -> Result<(Vec<[u32; 3]>, Topology)> {
+        let mut tris = Vec::with_capacity(m.faces.items.len());
+        for row in m.faces.rows() {
+            for i in 1..row.len().saturating_sub(1) {
+                tris.push([row[0], row[i], row[i + 1]]);
+            }
+        }
+        let t = Topology::new(m.positions.len(), &tris)?;
+        Ok((tris, t))
+    }
+
     /// Boundary loops as vertex sequences following the faces' orientation (each directed
-    /// boundary edge `a → b` as it appears in its face). Non-manifold boundary vertices (more
-    /// than two boundary edges) end a chain; open chains are returned as they are.
+    /// boundary edge `a → b` as it appears in its face): geom-core's `Topology::boundary_loops`
+    /// of the fan triangulation (whose extra diagonals are interior). Errors: see
+    /// [`Self::triangle_topology`].
+    pub fn try_boundary_loops(m: &PolyMesh) -> Result<Vec<Vec<u32>>> {
+        Ok(Self::triangle_topology(m)?.1.boundary_loops())
+    }
+
+    /// [`Self::try_boundary_loops`] for meshes known to be manifold and consistently oriented;
+    /// returns no loop for a mesh geom-core's topology rejects (use `try_boundary_loops` to get
+    /// the error).
     pub fn boundary_loops(&self, m: &PolyMesh) -> Vec<Vec<u32>> {
-        let mut next: HashMap<u32, u32> = HashMap::new();
-        for (e, _) in self.edges.iter().enumerate() {
-            if !self.is_boundary_edge(e) {
-                continue;
-            }
-            let f = self.edge_faces.row(e)[0] as usize;
-            let row = m.faces.row(f);
-            let fe = self.face_edges.row(f);
-            let i = fe.iter().position(|&x| x as usize == e).expect("edge belongs to its face (built together)");
-            next.insert(row[i], row[(i + 1) % row.len()]);
-        }
-        let mut starts: Vec<u32> = next.keys().copied().collect();
-        starts.sort_unstable();
-        let mut used = std::collections::HashSet::new();
-        let mut loops = Vec::new();
-        for s in starts {
-            if used.contains(&s) {
-                continue;
-            }
-            let mut lp = vec![s];
-            used.insert(s);
-            let mut v = s;
-            while let Some(&w) = next.get(&v) {
-                if w == s || used.contains(&w) {
-                    break;
-                }
-                used.insert(w);
-                lp.push(w);
-                v = w;
-            }
-            loops.push(lp);
-        }
-        loops
+        Self::try_boundary_loops(m).unwrap_or_default()
     }
 }
 

@@ -14,6 +14,9 @@
 use crate::error::{BarNetError, Result};
 use geom_core::math::{Mat3, Pt3, Vec3};
 use geom_core::mesh::PolyMesh;
+/// Closest point on a triangle and its barycentric coordinates (Ericson §5.1.5), from
+/// geom-core; re-exported under its former path.
+pub use geom_core::query::closest_point_triangle;
 
 /// One fine vertex's binding to one control triangle.
 #[derive(Clone, Copy, Debug)]
@@ -32,46 +35,6 @@ pub struct WrapBinding {
     binds: Vec<Bind>,
     k: usize,
     frames: Vec<Mat3>,
-}
-
-/// Closest point on triangle `t` to `p` and its barycentric coordinates (Ericson, Real-Time
-/// Collision Detection §5.1.5). Should be `geom_core::query::closest_point_triangle` (not
-/// available when this crate was written).
-pub fn closest_point_triangle(p: &Pt3, t: &[Pt3; 3]) -> (Pt3, [f64; 3]) {
-    let (a, b, c) = (t[0], t[1], t[2]);
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return (a, [1.0, 0.0, 0.0]);
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return (b, [0.0, 1.0, 0.0]);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (a + ab * v, [1.0 - v, v, 0.0]);
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return (c, [0.0, 0.0, 1.0]);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (a + ac * w, [1.0 - w, 0.0, w]);
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (b + (c - b) * w, [0.0, 1.0 - w, w]);
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    (a + ab * v + ac * w, [1.0 - v - w, v, w])
 }
 
 /// Orthonormal frame `[e₁ e₂ n]` (columns) of a triangle, `None` when its area is < 1e-14.
@@ -188,8 +151,8 @@ mod tests {
     /// Spec 7.3 d: rest fine mesh reproduced exactly; rigid motion ⇒ rigid (1e-12).
     #[test]
     fn wrap_reproduces_rest_and_is_rigid() {
-        let control = crate::arm::open_tube(8, 22, 0.045, 0.57);
-        let fine = crate::arm::open_tube(13, 31, 0.05, 0.57).positions;
+        let control = crate::arm::open_tube(8, 22, 0.045, 0.57).unwrap();
+        let fine = crate::arm::open_tube(13, 31, 0.05, 0.57).unwrap().positions;
         for k in [1, 4] {
             let mut w = WrapBinding::bind(&control, &fine, k).unwrap();
             let mut out = vec![Pt3::origin(); fine.len()];

@@ -97,21 +97,11 @@ impl<const K: usize> Dqs<K> {
     /// Binds rest positions (and optional normals) with packed weights sorted by decreasing
     /// weight (as [`PackedWeights::from_sparse`] makes them). Errors: sizes differ.
     pub fn new(rest: Vec<[f32; 3]>, rest_normals: Option<Vec<[f32; 3]>>, weights: PackedWeights<K>) -> Result<Self> {
-        if weights.len() != rest.len() {
-            return Err(SkinError::Size { what: "DQS weights rows", expected: rest.len(), got: weights.len() });
-        }
-        if let Some(n) = &rest_normals {
-            if n.len() != rest.len() {
-                return Err(SkinError::Size { what: "DQS rest normals", expected: rest.len(), got: n.len() });
-            }
-        }
-        let max_bone = weights
-            .bone
-            .iter()
-            .zip(&weights.w)
-            .flat_map(|(b, w)| (0..K).filter(move |&k| w[k] > 0.0).map(move |k| b[k] as usize))
-            .max()
-            .unwrap_or(0);
+        let max_bone = weights.check_bind(
+            rest.len(),
+            rest_normals.as_ref().map(|n| n.len()),
+            ["DQS weights rows", "DQS rest normals"],
+        )?;
         Ok(Dqs {
             rest,
             rest_n: rest_normals,

@@ -58,21 +58,11 @@ impl<const K: usize> Lbs<K> {
     /// Binds rest positions (and optionally rest normals) with packed weights. Errors: sizes
     /// differ.
     pub fn new(rest: Vec<[f32; 3]>, rest_normals: Option<Vec<[f32; 3]>>, weights: PackedWeights<K>) -> Result<Self> {
-        if weights.len() != rest.len() {
-            return Err(SkinError::Size { what: "LBS weights rows", expected: rest.len(), got: weights.len() });
-        }
-        if let Some(n) = &rest_normals {
-            if n.len() != rest.len() {
-                return Err(SkinError::Size { what: "LBS rest normals", expected: rest.len(), got: n.len() });
-            }
-        }
-        let max_bone = weights
-            .bone
-            .iter()
-            .zip(&weights.w)
-            .flat_map(|(b, w)| (0..K).filter(move |&k| w[k] > 0.0).map(move |k| b[k] as usize))
-            .max()
-            .unwrap_or(0);
+        let max_bone = weights.check_bind(
+            rest.len(),
+            rest_normals.as_ref().map(|n| n.len()),
+            ["LBS weights rows", "LBS rest normals"],
+        )?;
         Ok(Lbs { rest, rest_n: rest_normals, weights, max_bone, mats: Vec::new(), blend: LbsBlend::default() })
     }
 

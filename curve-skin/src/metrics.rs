@@ -2,18 +2,13 @@
 //! distance to the posed bones, fold fraction of a deformation map, influence histograms.
 
 use geom_core::math::{AsPt3, Pt3, Vec3};
+use geom_core::query::closest_point_segment;
 
 /// Signed volume enclosed by a closed, outward-oriented triangle mesh (divergence theorem,
-/// `Σ x_a·(x_b × x_c)/6`, accumulated in `f64`; positive for outward faces).
+/// accumulated in `f64`; positive for outward faces): `geom_core::mesh::signed_volume`, which
+/// takes the bounding-box centre as reference point (better conditioned than the origin).
 pub fn signed_volume<P: AsPt3>(pos: &[P], tris: &[[u32; 3]]) -> f64 {
-    let mut v = 0.0;
-    for t in tris {
-        let a = pos[t[0] as usize].pt3().coords;
-        let b = pos[t[1] as usize].pt3().coords;
-        let c = pos[t[2] as usize].pt3().coords;
-        v += a.dot(&b.cross(&c));
-    }
-    v / 6.0
+    geom_core::mesh::signed_volume(tris, pos)
 }
 
 /// Joint radius ratio: over the rest vertices within `sqrt(radius² + band²)` of the rest joint
@@ -74,14 +69,6 @@ pub fn ring_radius_ratio<P: AsPt3, Q: AsPt3>(
     }
 }
 
-/// Distance from a point to a segment.
-pub fn point_segment_distance(p: &Pt3, a: &Pt3, b: &Pt3) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 { ((p - a).dot(&ab) / l2).clamp(0.0, 1.0) } else { 0.0 };
-    (a + ab * t - p).norm()
-}
-
 /// Number of intersecting triangle pairs that share no vertex (spec §2.4; geom-core's AABB tree
 /// broad phase and exact triangle–triangle test). Pairs sharing a vertex are adjacent by
 /// construction and skipped.
@@ -95,7 +82,7 @@ pub fn distance_to_bones<P: AsPt3>(pos: &[P], bones: &[(Pt3, Pt3)]) -> (f64, f64
     let mut hi: f64 = 0.0;
     for p in pos {
         let p = p.pt3();
-        let d = bones.iter().map(|(a, b)| point_segment_distance(&p, a, b)).fold(f64::INFINITY, f64::min);
+        let d = bones.iter().map(|(a, b)| (closest_point_segment(&p, a, b).1 - p).norm()).fold(f64::INFINITY, f64::min);
         lo = lo.min(d);
         hi = hi.max(d);
     }

@@ -2,15 +2,18 @@
 //! ramp weights, and a capsule humanoid (straight tapered capsules per limb in a T-pose, on a
 //! 22-joint skeleton) with simple inverse-distance weights.
 //!
-//! The tube generator here is local to the crate (geom-core's `procedural::tube` was not yet
-//! available when this was written; it should replace [`capsule`] — listed in the README).
+//! Tubes come from `geom_core::procedural::tube` ([`capsule`] moves its rings onto a tapered,
+//! optionally rounded profile); distances to bone segments from `geom_core::query`.
 
 use geom_core::anim::skin::SkinSkeleton;
 use geom_core::math::{smoothstep, Pt3, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::error::Result;
-use crate::metrics::point_segment_distance;
+use geom_core::mesh::{NormalWeight, PolyMesh};
+use geom_core::procedural::{tube, Caps, TubeSpec};
+use geom_core::query::closest_point_segment;
+
+use crate::error::{Result, SkinError};
 use crate::weights::PackedWeights;
 
 /// A triangle mesh for skinning (outward, counter-clockwise faces).
@@ -41,29 +44,21 @@ impl SkinMesh {
     }
 }
 
-/// Area-weighted vertex normals of any positions sharing `tris`.
+/// Area-weighted unit vertex normals of any positions sharing `tris` (zero for isolated
+/// vertices): `geom_core::mesh::vertex_normals` with [`NormalWeight::Area`].
 pub fn vertex_normals<P: geom_core::math::AsPt3>(pos: &[P], tris: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut n = vec![Vec3::zeros(); pos.len()];
-    for t in tris {
-        let (a, b, c) = (pos[t[0] as usize].pt3(), pos[t[1] as usize].pt3(), pos[t[2] as usize].pt3());
-        let f = (b - a).cross(&(c - a));
-        for &i in t {
-            n[i as usize] += f;
-        }
-    }
-    for v in n.iter_mut() {
-        let l = v.norm();
-        if l > 0.0 {
-            *v /= l;
-        }
-    }
-    n
+    geom_core::mesh::vertex_normals(tris, pos, NormalWeight::Area)
 }
 
 /// Closed tube along the segment `a → b`: `rings` rings of `segments` vertices, ring `i` at
 /// parameter `t_i = i/(rings−1)` with radius `radius(t_i)`, closed by fan caps (one centre vertex
 /// per end). `end_round` > 0 adds that many extra rings per end on a hemisphere of the end radius
 /// (a capsule) before the cap vertex. Faces are outward.
+///
+/// The topology, vertex layout and ring frame are those of [`geom_core::procedural::tube`] (a unit
+/// tube with [`Caps::Fan`], quads split along `(r,k)–(r+1,k+1)`); its rings are moved onto the
+/// capsule profile. Errors: fewer than 2 rings or 3 segments, a zero-length axis, a non-finite or
+/// non-positive radius.
 pub fn capsule(
     a: Pt3,
     b: Pt3,
@@ -71,14 +66,15 @@ pub fn capsule(
     rings: usize,
     segments: usize,
     end_round: usize,
-) -> SkinMesh {
+) -> Result<SkinMesh> {
     let axis = b - a;
     let len = axis.norm();
+    if rings < 2 || segments < 3 || !(len > 0.0 && len.is_finite()) {
+        return Err(SkinError::Param(format!(
+            "capsule needs rings ≥ 2, segments ≥ 3 and a finite non-zero axis, got {rings}, {segments}, |b − a| = {len}"
+        )));
+    }
     let x = axis / len;
-    let helper = if x.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
-    let y = x.cross(&helper).normalize();
-    let z = x.cross(&y);
-    let mut pos = Vec::new();
     // Ring list (centre, radius) from a to b, including the hemispherical end rings.
     let mut ring_list: Vec<(Pt3, f64)> = Vec::new();
     let r0 = radius(0.0);
@@ -95,36 +91,33 @@ pub fn capsule(
         let ang = std::f64::consts::FRAC_PI_2 * k as f64 / (end_round + 1) as f64;
         ring_list.push((b + x * (r1 * ang.sin()), r1 * ang.cos()));
     }
-    for (c, r) in &ring_list {
-        for j in 0..segments {
-            let phi = 2.0 * std::f64::consts::PI * j as f64 / segments as f64;
-            pos.push(c + (y * phi.cos() + z * phi.sin()) * *r);
-        }
+    if let Some(i) = ring_list.iter().position(|(_, r)| !(*r > 0.0 && r.is_finite())) {
+        return Err(SkinError::Param(format!("capsule ring {i}: radius must be positive and finite")));
     }
     let nr = ring_list.len();
-    let s = segments as u32;
-    let mut tris = Vec::with_capacity(2 * segments * nr);
-    for i in 0..nr as u32 - 1 {
-        for j in 0..s {
-            let jn = (j + 1) % s;
-            let (p, q, r, t) = (i * s + j, i * s + jn, (i + 1) * s + jn, (i + 1) * s + j);
-            tris.push([p, q, r]);
-            tris.push([p, r, t]);
+    let spec = TubeSpec {
+        radius: 1.0,
+        length: 1.0,
+        around: segments as u32,
+        along: (nr - 1) as u32,
+        start: Pt3::origin(),
+        axis: x,
+        caps: Caps::Fan,
+    };
+    let unit = tube(&spec)?;
+    // Tube ring r is centred at (r/along)·x̂ with unit radius: move it onto the profile.
+    let n = segments;
+    let mut pos = Vec::with_capacity(unit.positions.len());
+    for (r, (c, rad)) in ring_list.iter().enumerate() {
+        let centre = Pt3::origin() + x * (r as f64 / (nr - 1) as f64);
+        for k in 0..n {
+            pos.push(c + (unit.positions[r * n + k] - centre) * *rad);
         }
     }
-    let ca = pos.len() as u32;
-    let cap_a = if end_round > 0 { a - x * r0 } else { a };
-    pos.push(cap_a);
-    let cb = pos.len() as u32;
-    let cap_b = if end_round > 0 { b + x * r1 } else { b };
-    pos.push(cap_b);
-    let last = (nr as u32 - 1) * s;
-    for j in 0..s {
-        let jn = (j + 1) % s;
-        tris.push([ca, jn, j]);
-        tris.push([cb, last + j, last + jn]);
-    }
-    SkinMesh { positions: pos, tris }
+    pos.push(if end_round > 0 { a - x * r0 } else { a });
+    pos.push(if end_round > 0 { b + x * r1 } else { b });
+    let (tri, _) = PolyMesh { positions: pos, faces: unit.faces, uv: None }.triangulate_fan()?;
+    Ok(SkinMesh { positions: tri.positions, tris: tri.faces })
 }
 
 /// The cylinder arm of spec §7: axis x ∈ [−bone_len, bone_len], joint (elbow) at the origin,
@@ -133,7 +126,7 @@ pub fn capsule(
 pub fn cylinder_arm(radius: f64, bone_len: f64, rings: usize, segments: usize) -> Result<(SkinMesh, SkinSkeleton)> {
     let a = Pt3::new(-bone_len, 0.0, 0.0);
     let b = Pt3::new(bone_len, 0.0, 0.0);
-    let m = capsule(a, b, &|_| radius, rings.max(2), segments.max(3), 0);
+    let m = capsule(a, b, &|_| radius, rings.max(2), segments.max(3), 0)?;
     let sk = SkinSkeleton::from_positions(
         vec!["shoulder".into(), "elbow".into(), "wrist".into()],
         vec![None, Some(0), Some(1)],
@@ -289,30 +282,25 @@ pub fn humanoid(res: f64) -> Result<Humanoid> {
         k[0].1 + (k[1].1 - k[0].1) * smoothstep(0.0, 1.0, u)
     };
     // Flat-ended torso: a rounded bottom would hang between the legs and bind to both thighs.
-    add(capsule(Pt3::new(0.0, 0.92, 0.0), Pt3::new(0.0, 1.55, 0.0), &torso, n(130.0), n(96.0), 0), 0, &mut mesh);
-    add(capsule(Pt3::new(0.0, 1.6, 0.0), Pt3::new(0.0, 1.76, 0.0), &|_| 0.09, n(40.0), n(64.0), n(12.0)), 1, &mut mesh);
-    for (s, id) in [(1.0, 2u8), (-1.0, 3u8)] {
-        let arm = |t: f64| 0.055 - 0.025 * t;
-        add(
-            capsule(Pt3::new(0.16 * s, 1.45, 0.0), Pt3::new(0.86 * s, 1.45, 0.0), &arm, n(150.0), n(48.0), n(6.0)),
-            id,
-            &mut mesh,
-        );
-    }
-    for (s, id) in [(1.0, 4u8), (-1.0, 5u8)] {
-        let leg = |t: f64| 0.085 - 0.04 * t;
-        add(
-            capsule(Pt3::new(0.1 * s, 0.98, 0.0), Pt3::new(0.1 * s, 0.08, 0.0), &leg, n(180.0), n(48.0), n(6.0)),
-            id,
-            &mut mesh,
-        );
-    }
-    for (s, id) in [(1.0, 6u8), (-1.0, 7u8)] {
-        add(
-            capsule(Pt3::new(0.1 * s, 0.05, -0.03), Pt3::new(0.1 * s, 0.04, 0.17), &|_| 0.04, n(40.0), n(32.0), n(5.0)),
-            id,
-            &mut mesh,
-        );
+    add(capsule(Pt3::new(0.0, 0.92, 0.0), Pt3::new(0.0, 1.55, 0.0), &torso, n(130.0), n(96.0), 0)?, 0, &mut mesh);
+    add(
+        capsule(Pt3::new(0.0, 1.6, 0.0), Pt3::new(0.0, 1.76, 0.0), &|_| 0.09, n(40.0), n(64.0), n(12.0))?,
+        1,
+        &mut mesh,
+    );
+    // Limbs (arms, legs, feet), left then right: ends (x scaled by the side), radius profile,
+    // rings, segments, rounded end rings, piece id of the left one.
+    type Limb<'a> = ([f64; 3], [f64; 3], &'a dyn Fn(f64) -> f64, f64, f64, f64, u8);
+    let limbs: [Limb; 3] = [
+        ([0.16, 1.45, 0.0], [0.86, 1.45, 0.0], &|t| 0.055 - 0.025 * t, 150.0, 48.0, 6.0, 2),
+        ([0.1, 0.98, 0.0], [0.1, 0.08, 0.0], &|t| 0.085 - 0.04 * t, 180.0, 48.0, 6.0, 4),
+        ([0.1, 0.05, -0.03], [0.1, 0.04, 0.17], &|_| 0.04, 40.0, 32.0, 5.0, 6),
+    ];
+    for (a, b, radius, rings, segs, round, id) in limbs {
+        for (s, side) in [(1.0, 0u8), (-1.0, 1u8)] {
+            let (pa, pb) = (Pt3::new(a[0] * s, a[1], a[2]), Pt3::new(b[0] * s, b[1], b[2]));
+            add(capsule(pa, pb, radius, n(rings), n(segs), n(round))?, id + side, &mut mesh);
+        }
     }
     Ok(Humanoid { mesh, skeleton: sk, piece })
 }
@@ -334,7 +322,7 @@ pub fn inverse_distance_weights(rest: &[Pt3], sk: &SkinSkeleton, power: f64, min
         .map(|x| {
             let mut d = vec![f64::INFINITY; sk.len()];
             for (j, a, b) in &segs {
-                d[*j] = d[*j].min(point_segment_distance(x, a, b));
+                d[*j] = d[*j].min((closest_point_segment(x, a, b).1 - x).norm());
             }
             let w: Vec<f64> = d.iter().map(|&d| if d.is_finite() { (d + 1e-4).powf(-power) } else { 0.0 }).collect();
             let s: f64 = w.iter().sum();
@@ -379,7 +367,7 @@ mod tests {
 
     #[test]
     fn capsule_and_humanoid_volumes_are_positive() {
-        let c = capsule(Pt3::new(0.0, 0.0, 0.0), Pt3::new(0.0, 1.0, 0.0), &|t| 0.1 + 0.05 * t, 20, 16, 4);
+        let c = capsule(Pt3::new(0.0, 0.0, 0.0), Pt3::new(0.0, 1.0, 0.0), &|t| 0.1 + 0.05 * t, 20, 16, 4).unwrap();
         assert!(signed_volume(&c.positions, &c.tris) > 0.0);
         let h = humanoid(0.25).unwrap();
         assert!(signed_volume(&h.mesh.positions, &h.mesh.tris) > 0.0);

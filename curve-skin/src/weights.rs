@@ -17,6 +17,33 @@ pub struct PackedWeights<const K: usize> {
 }
 
 impl<const K: usize> PackedWeights<K> {
+    /// Checks a skinner's bind data against these weights and returns the largest bone index
+    /// with a positive weight (0 when none), so `prepare` can reject too-small skeletons.
+    /// `what` names the rows and the normals in the size error (e.g. "LBS weights rows").
+    /// Errors: [`SkinError::Size`] when the row or normal count differs from `rest_len`.
+    pub(crate) fn check_bind(
+        &self,
+        rest_len: usize,
+        normals_len: Option<usize>,
+        what: [&'static str; 2],
+    ) -> Result<usize> {
+        if self.len() != rest_len {
+            return Err(SkinError::Size { what: what[0], expected: rest_len, got: self.len() });
+        }
+        if let Some(n) = normals_len {
+            if n != rest_len {
+                return Err(SkinError::Size { what: what[1], expected: rest_len, got: n });
+            }
+        }
+        Ok(self
+            .bone
+            .iter()
+            .zip(&self.w)
+            .flat_map(|(b, w)| (0..K).filter(move |&k| w[k] > 0.0).map(move |k| b[k] as usize))
+            .max()
+            .unwrap_or(0))
+    }
+
     /// Number of vertices.
     pub fn len(&self) -> usize {
         self.w.len()

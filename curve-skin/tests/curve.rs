@@ -189,14 +189,7 @@ fn arc_is_circular_and_tangent_to_bones() {
     let cur = curve_skin(&a, CurveOptions::default());
     for bend in [20.0, 90.0, 140.0] {
         let (posed, _) = arm_pose(&a.sk, bend, 0.0);
-        let (f, _) = CurveFrame::new(
-            &cur.skeleton.curves[0],
-            &cur.rigs()[0],
-            &posed,
-            &FrameHistory::default(),
-            TwistChoice::Principal,
-            VolumeComp::Off,
-        );
+        let f = posed_curve(&cur, 0, &posed);
         let beta: f64 = f64::to_radians(bend);
         let r = f.l_cp / (beta / 2.0).tan();
         let t1 = -f.u_in;

@@ -1,15 +1,16 @@
 //! `cargo xtask bench curve-skin` (spec §9): accuracy against time for
 //! (a) the curve frame-table resolution (8 … 128 samples and exact, with and without the kink
 //! samples) on the reference arm bent 90° and twisted 90°: max vertex error vs the exact `f64`
-//! evaluation, in units of R;
+//! evaluation, in units of R, for both curve shapes (circular arc and quadratic B-spline);
 //! (b) the LBS influence count K ∈ {1, 2, 4, 8} on the humanoid walk: max / RMS vertex error vs
 //! all weights (the `f64` reference `geom_core::anim::skin::lbs`);
-//! (c) the three methods on the bent arm: volume error against ns per vertex.
+//! (c) the three methods (and the B-spline curve shape) on the bent arm: volume error against ns
+//! per vertex.
 //! Writes `accuracy_vs_time.csv`, `table_error.png`, `weights_error.png`, `pareto.png`.
 
 use std::time::Instant;
 
-use curve_skin::curve::{build_curve_skeleton, JointCurveDefaults, TopologyRules};
+use curve_skin::curve::{build_curve_skeleton, CurveShape, JointCurveDefaults, TopologyRules};
 use curve_skin::metrics::signed_volume;
 use curve_skin::poses::{axis_deg, walk_pose, SkinPose};
 use curve_skin::procedural::{cylinder_arm, humanoid, inverse_distance_weights, ramp_weights, Ramp};
@@ -76,10 +77,16 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     pose.set_world(&sk, 1, axis_deg(Vec3::z(), 90.0) * axis_deg(Vec3::x(), 90.0));
     let posed = pose.globals(&sk);
     let cskel = build_curve_skeleton(&sk, &TopologyRules::default(), &JointCurveDefaults::default());
+    let bskel = build_curve_skeleton(
+        &sk,
+        &TopologyRules::default(),
+        &JointCurveDefaults { shape: CurveShape::QuadraticBSpline, ..Default::default() },
+    );
     let mut out = vec![[0f32; 3]; n];
     let mut exact = vec![Pt3::origin(); n];
     let mut table_series: Vec<Series> = Vec::new();
-    for kinks in [true, false] {
+    for (shape, kinks) in [("arc", true), ("arc", false), ("bspline", true), ("bspline", false)] {
+        let cskel = if shape == "arc" { &cskel } else { &bskel };
         let mut pts = Vec::new();
         for k in [8usize, 16, 32, 64, 128, 0] {
             let opts = CurveOptions { table_samples: k, kink_samples: kinks, ..Default::default() };
@@ -88,7 +95,12 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             cur.deform_f64(&mut exact);
             let dt = time_deform(&cur, &mut out, min_t);
             let (mx, rms) = max_rms(&to_f64(&out), &exact);
-            let variant = if kinks { "with_kinks" } else { "no_kinks" };
+            let variant = match (shape, kinks) {
+                ("arc", true) => "with_kinks",
+                ("arc", false) => "no_kinks",
+                (_, true) => "bspline_with_kinks",
+                (_, false) => "bspline_no_kinks",
+            };
             let knob = if k == 0 { "exact".to_string() } else { k.to_string() };
             csv.row(&[
                 "table".into(),
@@ -102,15 +114,22 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             if k > 0 {
                 pts.push((k as f64, mx / r));
             }
+            let prefix = if shape == "arc" { "" } else { "bspline_" };
             if kinks && k == 64 {
-                summary.set("table64_max_error_over_r", mx / r);
-                summary.set("table64_curve_mverts_per_s", n as f64 / dt / 1e6);
+                summary.set(&format!("{prefix}table64_max_error_over_r"), mx / r);
+                summary.set(&format!("{prefix}table64_curve_mverts_per_s"), n as f64 / dt / 1e6);
             }
             if kinks && k == 0 {
-                summary.set("exact_curve_mverts_per_s", n as f64 / dt / 1e6);
+                summary.set(&format!("{prefix}exact_curve_mverts_per_s"), n as f64 / dt / 1e6);
             }
         }
-        table_series.push(Series::new(if kinks { "with kink samples" } else { "uniform only" }, pts));
+        let label = match (shape, kinks) {
+            ("arc", true) => "arc, with kink samples",
+            ("arc", false) => "arc, uniform only",
+            (_, true) => "B-spline, with kink + zone samples",
+            (_, false) => "B-spline, uniform only",
+        };
+        table_series.push(Series::new(label, pts));
     }
     let mut plot =
         LinePlot::new("curve table error (90° bend + 90° twist)", "table samples K", "max error / R").log(true, true);
@@ -182,6 +201,10 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
         ("lbs", Box::new(cs(Lbs::new(rest.clone(), None, w4.clone()))?)),
         ("dqs", Box::new(cs(Dqs::new(rest.clone(), None, w4))?)),
         ("curve", Box::new(cs(CurveSkin::new(&sk, cskel.clone(), &mesh.positions, None, CurveOptions::default()))?)),
+        (
+            "curve_bspline",
+            Box::new(cs(CurveSkin::new(&sk, bskel.clone(), &mesh.positions, None, CurveOptions::default()))?),
+        ),
     ];
     let mut pareto = Vec::new();
     for (m, s) in methods.iter_mut() {

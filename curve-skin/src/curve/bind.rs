@@ -141,9 +141,10 @@ pub(crate) fn weights_for_point(
     out: &mut Vec<Entry>,
 ) -> bool {
     out.clear();
-    let mut cands: Vec<(usize, f64, f64)> = Vec::new(); // (curve, curve distance, σ)
-                                                        // A curve whose domain holds the foot but which is much farther than the nearest skeleton
-                                                        // part (e.g. the neck curve seen from beyond a hand) is not a candidate.
+    // (curve, curve distance, σ). A curve whose domain holds the foot but which is much farther
+    // than the nearest skeleton part (e.g. the neck curve seen from beyond a hand) is not a
+    // candidate.
+    let mut cands: Vec<(usize, f64, f64)> = Vec::new();
     let band = opts.blend_band.max(1e-6);
     let near =
         frames.iter().zip(proj).filter(|(f, _)| f.length() > 1e-12).map(|(_, p)| p.dist).fold(f64::INFINITY, f64::min);

@@ -7,13 +7,21 @@
 //! the first bone's tangent. At σ = 0 the frame is `F_a`; at σ = 1 it is the second bone's travel
 //! frame `F_c` exactly, because θ is the twist of `F_c` relative to `Rot(b, β)·F_a` about the
 //! second bone (swing–twist decomposition), so neighbouring curves agree at bone midpoints.
+//!
+//! Two curve shapes through the Bone_CPs (spec §3.4.2): the circular arc (rational quadratic with
+//! middle weight cos(β/2), default) and the plain quadratic B-spline ([`super::bspline`]). With
+//! the centre on the skeleton, the skeleton zone `[s_J − L, s_J + L]` is mapped onto the curve's
+//! middle part by normalised arc length (the straight parts coincide), and ψ is the curve's
+//! tangent angle there: linear in `s` for the arc, `ψ(t(u))` for the B-spline. The swing about the
+//! constant binormal is the rotation-minimising frame of the planar curve.
 
 use geom_core::anim::skin::SkinSkeleton;
 use geom_core::math::{Iso3, Pt3, UnitQuat, Vec3};
-use nalgebra::Unit;
+use nalgebra::{Quaternion, Unit};
 use std::f64::consts::PI;
 
-use super::types::{BoneCp, BoneEnd, CentreMode, JointCurve, TwistDistribution, VolumeComp};
+use super::bspline::QuadBSpline;
+use super::types::{BoneCp, BoneEnd, CentreMode, CurveShape, JointCurve, TwistDistribution, VolumeComp};
 
 /// Largest volume-compensation scale applied whatever `max_scale` says (α → 90° at a fully
 /// folded joint would otherwise give an infinite offset).
@@ -92,6 +100,8 @@ pub struct CurveFrame {
     pub u_out: Vec3,
     /// First bone's travel frame `F_a`.
     pub f_in: UnitQuat,
+    /// `Rot(b, β)·F_a`: the swung frame after the zone (cached for [`CurveFrame::eval`]).
+    pub f_swung: UnitQuat,
     /// Unit binormal of the bend plane.
     pub b: Vec3,
     /// Bend angle β ∈ [0, π] (rad).
@@ -106,6 +116,8 @@ pub struct CurveFrame {
     pub l_out: f64,
     /// Centre mode.
     pub centre: CentreMode,
+    /// The B-spline shape for β (`None` = circular arc).
+    pub quad: Option<QuadBSpline>,
     /// Largest volume-compensation scale (`None` = off).
     pub max_scale: Option<f64>,
     /// The fold-free minimum L (floating rule without its safety factor) — or a fixed / keyed L —
@@ -173,6 +185,10 @@ impl CurveFrame {
             }
         };
         let (l_in, l_out) = (c.span_in * rig.len_in, c.span_out * rig.len_out);
+        let quad = match c.shape {
+            CurveShape::CircularArc => None,
+            CurveShape::QuadraticBSpline => Some(QuadBSpline::new(beta)),
+        };
         let span_cap = l_in.min(l_out);
         let (l_cp, cap_hit) = match &c.bone_cp {
             BoneCp::Fixed { dist } => (dist.min(span_cap).max(0.0), *dist > span_cap),
@@ -183,23 +199,13 @@ impl CurveFrame {
             BoneCp::Floating { skin_dist, safety, min, max_frac } => {
                 let d = skin_dist.unwrap_or(rig.skin_dist);
                 let half = 0.5 * beta;
-                let raw = match c.centre {
-                    CentreMode::OnSkeleton => {
-                        let ch = half.cos();
-                        if ch > 1e-12 {
-                            safety * d * beta / (2.0 * ch)
-                        } else {
-                            f64::INFINITY
-                        }
-                    }
-                    CentreMode::OnCurve => {
-                        let ch = half.cos();
-                        if ch > 1e-12 {
-                            safety * d * half.tan()
-                        } else {
-                            f64::INFINITY
-                        }
-                    }
+                let ch = half.cos();
+                let raw = match (c.centre, &quad) {
+                    (_, None) if ch <= 1e-12 => f64::INFINITY,
+                    (CentreMode::OnSkeleton, None) => safety * d * beta / (2.0 * ch),
+                    (CentreMode::OnCurve, None) => safety * d * half.tan(),
+                    (CentreMode::OnSkeleton, Some(q)) => safety * d * q.fold_factor_skeleton(),
+                    (CentreMode::OnCurve, Some(q)) => safety * d * q.fold_factor_curve(),
                 };
                 let cap = (max_frac * rig.len_in.min(rig.len_out)).min(span_cap);
                 let l = raw.max(*min).min(cap).max(0.0);
@@ -225,6 +231,7 @@ impl CurveFrame {
             u_in: -t1,
             u_out: t2,
             f_in,
+            f_swung: swing_end * f_in,
             b,
             beta,
             l_cp,
@@ -232,6 +239,7 @@ impl CurveFrame {
             l_in,
             l_out,
             centre: c.centre,
+            quad,
             max_scale,
             cap_hit,
         };
@@ -259,11 +267,17 @@ impl CurveFrame {
         [(self.l_in - self.l_cp) / s, self.l_in / s, (self.l_in + self.l_cp) / s]
     }
 
-    /// Swing angle ψ at skeleton arc length `s` (circular arc, skeleton association).
+    /// Swing angle ψ at skeleton arc length `s` (skeleton association: the zone `s_J ± L` maps
+    /// onto the curve's middle part by normalised arc length).
     fn psi_skeleton(&self, s: f64) -> f64 {
         let sj = self.l_in;
         if self.l_cp > 1e-12 {
-            self.beta * ((s - (sj - self.l_cp)) / (2.0 * self.l_cp)).clamp(0.0, 1.0)
+            let phi = ((s - (sj - self.l_cp)) / (2.0 * self.l_cp)).clamp(0.0, 1.0);
+            match &self.quad {
+                None => self.beta * phi,
+                Some(q) if phi > 0.0 && phi < 1.0 => q.psi(q.t_at_len(phi * q.total())),
+                Some(_) => self.beta * phi,
+            }
         } else if s >= sj {
             self.beta
         } else {
@@ -271,10 +285,13 @@ impl CurveFrame {
         }
     }
 
-    /// Arc radius, arc length and total curve length of the line–arc–line curve.
+    /// Arc radius, middle-part length and total curve length of the line–arc–line (or
+    /// line–B-spline–line) curve; the radius is ∞ for the B-spline.
     fn arc_dims(&self) -> (f64, f64, f64) {
         let l = self.l_cp;
-        let (r, a) = if self.beta < 1e-9 {
+        let (r, a) = if let Some(q) = &self.quad {
+            (f64::INFINITY, l * q.total())
+        } else if self.beta < 1e-9 {
             (f64::INFINITY, 2.0 * l)
         } else {
             let r = l / (0.5 * self.beta).tan();
@@ -296,6 +313,15 @@ impl CurveFrame {
         }
         if u <= first + a {
             let v = u - first;
+            if let Some(q) = &self.quad {
+                if self.l_cp <= 0.0 {
+                    return (p0, 0.0);
+                }
+                let t = q.t_at_len(v / self.l_cp);
+                let (x, y) = q.point_plane(t);
+                let n = self.b.cross(&t1);
+                return (self.j + (t1 * x + n * y) * self.l_cp, q.psi(t));
+            }
             if !r.is_finite() {
                 return (p0 + t1 * v, 0.0);
             }
@@ -326,7 +352,15 @@ impl CurveFrame {
         if d3 < best.0 {
             best = (d3, first + a + t);
         }
-        if !r.is_finite() {
+        if let Some(q) = &self.quad {
+            if self.l_cp > 0.0 {
+                let n = self.b.cross(&t1);
+                let (d2, t) = q.closest(&self.j, &t1, &n, &self.b, self.l_cp, x);
+                if d2 < best.0 {
+                    best = (d2, first + self.l_cp * q.len_unit(t));
+                }
+            }
+        } else if !r.is_finite() {
             let (d2, t) = seg(&p0, &t1, a);
             if d2 < best.0 {
                 best = (d2, first + t);
@@ -377,10 +411,17 @@ impl CurveFrame {
                 (p, psi, 0.0)
             }
         };
-        let tau = self.theta * twist.eval(sigma);
-        let rot = UnitQuat::from_axis_angle(&Unit::new_unchecked(self.b), psi)
-            * self.f_in
-            * UnitQuat::from_axis_angle(&Vec3::x_axis(), tau);
+        let (st, ct) = (0.5 * self.theta * twist.eval(sigma)).sin_cos();
+        let tw = UnitQuat::new_unchecked(Quaternion::new(ct, st, 0.0, 0.0));
+        // Outside the zone the swing is 0 or β: reuse F_a / Rot(b, β)·F_a (one sincos saved).
+        let swung = if psi <= 0.0 {
+            self.f_in
+        } else if psi >= self.beta {
+            self.f_swung
+        } else {
+            UnitQuat::from_axis_angle(&Unit::new_unchecked(self.b), psi) * self.f_in
+        };
+        let rot = swung * tw;
         let scale = match self.max_scale {
             None => 1.0,
             Some(m) => {

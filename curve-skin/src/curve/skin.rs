@@ -1,12 +1,13 @@
 //! The curve-skeleton skinner (spec §3.4.6, paper Eq. 3: `P = Σ_i w_i M(i, t)·P_L(u, d)`).
 //!
 //! `prepare` builds each curve's posed state (β, b, L, θ) and, with `table_samples = K > 0`, a
-//! table of `K + 1` uniform samples plus the three kinks (σ_J, s_J ± L) holding the centre, the
-//! frame quaternion (hemisphere-aligned along the table) and the volume scale, in `f32`.
-//! `deform` locates σ through a per-cell index (at most three kinks per curve, so ≤ 3 extra steps),
-//! lerps the centre and scale, nlerps the quaternion and rotates the local offset:
-//! `x' = Σ w (c + R(q)·s·ℓ)`. With `table_samples = 0` the closed form is evaluated per vertex in
-//! `f64`. [`CurveSkin::deform_f64`] is the exact `f64` path of the tests.
+//! table of `K + 1` uniform samples plus the three kinks (σ_J, s_J ± L; four more inside a
+//! B-spline's zone) holding the centre, the frame quaternion (hemisphere-aligned along the table)
+//! and the volume scale, in `f32`. `deform` locates σ through a per-cell index (at most seven
+//! extra samples per curve, so ≤ 7 extra steps), lerps the centre and scale, nlerps the
+//! quaternion and rotates the local offset: `x' = Σ w (c + R(q)·s·ℓ)`. With `table_samples = 0`
+//! the closed form is evaluated per vertex in `f64`. [`CurveSkin::deform_f64`] is the exact
+//! `f64` path of the tests.
 
 use std::ops::Range;
 
@@ -19,6 +20,9 @@ use super::types::{CurveOptions, CurveSkeleton};
 use crate::dqs::qrot;
 use crate::error::{Result, SkinError};
 use crate::skinner::{normalize3, DeformOutput, Skinner};
+
+/// Non-uniform table samples per curve: the three kinks plus four inside a B-spline's zone.
+const MAX_EXTRA: usize = 7;
 
 /// Per-frame diagnostics.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -169,7 +173,8 @@ impl CurveSkin {
     fn build_tables(&mut self) {
         let k = self.opts.table_samples;
         let nc = self.frames.len();
-        let stride = k + 4;
+        // K + 1 uniform samples, 3 kinks and, for the B-spline, 4 more inside the zone s_J ± L.
+        let stride = k + 1 + MAX_EXTRA;
         let t = &mut self.tab;
         if t.k != k || t.count.len() != nc {
             *t = Tables {
@@ -189,13 +194,22 @@ impl CurveSkin {
         for c in 0..self.frames.len() {
             let (frame, twist) = (&self.frames[c], &self.skeleton.curves[c].twist);
             // Samples: uniform plus kinks, sorted, without near-duplicates (no allocation).
-            let mut kinks = [0f64; 3];
+            let mut kinks = [0f64; MAX_EXTRA];
             let mut nk = 0usize;
             if self.opts.kink_samples {
-                for s in frame.kinks() {
+                let kk = frame.kinks();
+                let mut add = |s: f64| {
                     if s > 0.0 && s < 1.0 {
                         kinks[nk] = s;
                         nk += 1;
+                    }
+                };
+                kk.iter().for_each(|&s| add(s));
+                if frame.quad.is_some() {
+                    // The B-spline's swing rate peaks at the joint: resolve the short zone
+                    // (§3.4.6 bound of 2e-3 R at K = 64 holds with these, not without).
+                    for j in [1.0, 2.0, 4.0, 5.0] {
+                        add(kk[0] + (kk[2] - kk[0]) * j / 6.0);
                     }
                 }
             }

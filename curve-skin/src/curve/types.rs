@@ -53,10 +53,14 @@ impl Default for BoneCp {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub enum CurveShape {
     /// Rational quadratic with middle weight `cos(β/2)`: the circular arc tangent to both bones,
-    /// radius `L / tan(β/2)` (spec §3.4.2, default). (The plain quadratic B-spline option of the
-    /// spec is not implemented; see README.)
+    /// radius `L / tan(β/2)` (spec §3.4.2, default). Its tangent angle grows linearly with arc
+    /// length, so it is fold-free with the smallest `L`.
     #[default]
     CircularArc,
+    /// The paper's plain quadratic B-spline (weight 1) on the same control points
+    /// ([`super::bspline::QuadBSpline`]): curvature concentrates at the joint, so the floating
+    /// rule needs a larger `L` (≈ 1.46× the arc's at 90°) to stay fold-free.
+    QuadraticBSpline,
 }
 
 /// Twist distribution `D: [0,1] → [0,1]` along the curve (spec §3.4.4).

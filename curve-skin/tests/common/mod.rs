@@ -1,7 +1,9 @@
 //! Shared set-up of the integration tests: the reference cylinder arm of spec §7 and helpers.
 #![allow(dead_code)]
 
-use curve_skin::curve::{build_curve_skeleton, JointCurveDefaults, TopologyRules};
+use curve_skin::curve::{
+    build_curve_skeleton, CurveFrame, FrameHistory, JointCurveDefaults, TopologyRules, TwistChoice, VolumeComp,
+};
 use curve_skin::poses::{axis_deg, SkinPose};
 use curve_skin::procedural::{cylinder_arm, ramp_weights, Ramp, SkinMesh};
 use curve_skin::{CurveOptions, CurveSkin, PackedWeights, SkinSkeleton};
@@ -42,6 +44,19 @@ pub fn arm_pose(sk: &SkinSkeleton, bend_deg: f64, twist_deg: f64) -> (Vec<Iso3>,
     let mut p = SkinPose::rest(sk);
     p.set_world(sk, 1, axis_deg(Vec3::z(), bend_deg) * axis_deg(Vec3::x(), twist_deg));
     (p.globals(sk), p)
+}
+
+/// Curve `i` of `cur` in the posed frames (principal twist, fresh history, no compensation).
+pub fn posed_curve(cur: &CurveSkin, i: usize, posed: &[Iso3]) -> CurveFrame {
+    CurveFrame::new(
+        &cur.skeleton.curves[i],
+        &cur.rigs()[i],
+        posed,
+        &FrameHistory::default(),
+        TwistChoice::Principal,
+        VolumeComp::Off,
+    )
+    .0
 }
 
 pub fn curve_skin(a: &Arm, opts: CurveOptions) -> CurveSkin {

@@ -13,7 +13,10 @@
 use std::path::Path;
 use std::time::Instant;
 
-use curve_skin::curve::{build_curve_skeleton, JointCurveDefaults, TopologyRules, VolumeComp};
+use curve_skin::curve::{
+    build_curve_skeleton, polyline_length, ActionLine, CurveShape, JointCurveDefaults, MuscleBulge, TopologyRules,
+    VolumeComp,
+};
 use curve_skin::metrics::{
     distance_to_bones, fold_fraction, histogram_mean, influences_histogram, joint_radius_ratio, ring_radius_ratio,
     self_intersections, signed_volume,
@@ -61,6 +64,22 @@ fn write_obj(dir: &Path, name: &str, pos: &[[f32; 3]], tris: &[[u32; 3]]) -> Res
     Ok(())
 }
 
+/// Writes a polyline (an action line) as an OBJ with one `l` element.
+fn write_polyline(dir: &Path, name: &str, pts: &[Pt3]) -> Result<()> {
+    crate::out::ensure_dir(dir)?;
+    let mut s = String::from("# curve-skin muscle action line\n");
+    for p in pts {
+        s.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    s.push('l');
+    for i in 1..=pts.len() {
+        s.push_str(&format!(" {i}"));
+    }
+    s.push('\n');
+    let path = dir.join(name);
+    std::fs::write(&path, s).map_err(crate::error::io_err(path))
+}
+
 /// Deforms with one skinner (single thread), returns positions and seconds.
 fn timed(s: &dyn Skinner, out: &mut [[f32; 3]]) -> f64 {
     let t = Instant::now();
@@ -104,12 +123,38 @@ struct ArmParams {
     comp_max_scale: Option<f64>,
     /// Angle (degrees) whose figures go to summary.json without suffix.
     summary_deg: f64,
+    /// Curve shapes compared (spec §3.4.2): the first is method `curve` (and `curve_comp`), a
+    /// `QuadraticBSpline` after a `CircularArc` becomes `curve_bspline`. Default `[CircularArc]`.
+    #[serde(default = "default_shapes")]
+    shapes: Vec<CurveShape>,
+    /// Optional muscle action line (spec §3.4.8) driven by the `curve` method.
+    #[serde(default)]
+    muscle: Option<MuscleParams>,
+}
+
+fn default_shapes() -> Vec<CurveShape> {
+    vec![CurveShape::CircularArc]
+}
+
+/// A muscle action line on the arm: control points in units of R along y and of bone_len
+/// along x, rest muscle radius and bulge capsule radius in units of R.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MuscleParams {
+    /// Control points `(x / bone_len, y / R, z / R)`.
+    points: Vec<(f64, f64, f64)>,
+    /// Rest muscle radius ÷ R.
+    radius: f64,
+    /// Bulge capsule radius ÷ R.
+    influence: f64,
 }
 
 struct ArmMethod {
     name: String,
     skinner: Box<dyn Skinner>,
     curve: bool,
+    /// The exact f64 twin of a curve method (fold analysis, f64 figures).
+    twin: Option<Box<CurveSkin>>,
 }
 
 /// The `elbow-bend` and `candy-wrapper` scenes.
@@ -140,18 +185,31 @@ pub fn run_arm(ctx: &RunCtx) -> Result<Summary> {
             name: format!("lbs_{tag}"),
             skinner: Box::new(cs(Lbs::<4>::new(rest32.clone(), None, widen(&w2)))?),
             curve: false,
+            twin: None,
         });
         methods.push(ArmMethod {
             name: format!("dqs_{tag}"),
             skinner: Box::new(cs(Dqs::<4>::new(rest32.clone(), None, widen(&w2)))?),
             curve: false,
+            twin: None,
         });
     }
-    let cskel = build_curve_skeleton(&sk, &TopologyRules::default(), &JointCurveDefaults::default());
+    if p.shapes.is_empty() {
+        return Err(scene::invalid(&ctx.scene_file, "shapes must name at least one curve shape"));
+    }
+    let skel_for = |shape: CurveShape| {
+        let d = JointCurveDefaults { shape, ..Default::default() };
+        build_curve_skeleton(&sk, &TopologyRules::default(), &d)
+    };
+    let cskel = skel_for(p.shapes[0]);
+    let new_curve = |cskel: &curve_skin::CurveSkeleton, o: CurveOptions| {
+        cs(CurveSkin::new(&sk, cskel.clone(), &mesh.positions, None, o))
+    };
     methods.push(ArmMethod {
         name: "curve".into(),
-        skinner: Box::new(cs(CurveSkin::new(&sk, cskel.clone(), &mesh.positions, None, CurveOptions::default()))?),
+        skinner: Box::new(new_curve(&cskel, CurveOptions::default())?),
         curve: true,
+        twin: Some(Box::new(new_curve(&cskel, CurveOptions::default())?)),
     });
     let comp = CurveOptions {
         volume_comp: VolumeComp::Isotropic { max_scale: p.comp_max_scale.unwrap_or(f64::INFINITY) },
@@ -159,11 +217,33 @@ pub fn run_arm(ctx: &RunCtx) -> Result<Summary> {
     };
     methods.push(ArmMethod {
         name: "curve_comp".into(),
-        skinner: Box::new(cs(CurveSkin::new(&sk, cskel.clone(), &mesh.positions, None, comp))?),
+        skinner: Box::new(new_curve(&cskel, comp)?),
         curve: true,
+        twin: None,
     });
-    // The exact f64 curve path for the max-distance figure.
-    let mut curve64 = cs(CurveSkin::new(&sk, cskel, &mesh.positions, None, CurveOptions::default()))?;
+    for &shape in &p.shapes[1..] {
+        let name = match shape {
+            CurveShape::CircularArc => "curve_arc",
+            CurveShape::QuadraticBSpline => "curve_bspline",
+        };
+        let sk2 = skel_for(shape);
+        methods.push(ArmMethod {
+            name: name.into(),
+            skinner: Box::new(new_curve(&sk2, CurveOptions::default())?),
+            curve: true,
+            twin: Some(Box::new(new_curve(&sk2, CurveOptions::default())?)),
+        });
+    }
+    // Muscle action line driven by the `curve` method's exact twin.
+    let muscle = match &p.muscle {
+        None => None,
+        Some(mp) => {
+            let pts: Vec<Pt3> = mp.points.iter().map(|&(x, y, z)| Pt3::new(x * p.bone_len, y * r, z * r)).collect();
+            let line = cs(ActionLine::new(pts))?;
+            let bulge = cs(MuscleBulge::new(&line, &mesh.positions, mp.radius * r, mp.influence * r))?;
+            Some((line, bulge))
+        }
+    };
 
     let mut rng = Rng::new(5);
     let samples: Vec<Pt3> = (0..n_fold)
@@ -189,6 +269,13 @@ pub fn run_arm(ctx: &RunCtx) -> Result<Summary> {
             "time_s",
         ],
     )?;
+    let mut muscle_csv = match muscle {
+        Some(_) => Some(CsvWriter::create(
+            &ctx.out_dir.join("muscle.csv"),
+            &["angle_deg", "length_ratio", "length_over_r", "bulge_volume_ratio"],
+        )?),
+        None => None,
+    };
     let mut series: Vec<Vec<Vec<(f64, f64)>>> = vec![vec![Vec::new(); methods.len()]; 3];
     let mut summary = Summary::new();
     summary.set_str("mode", ctx.mode.name());
@@ -222,12 +309,13 @@ pub fn run_arm(ctx: &RunCtx) -> Result<Summary> {
             let (lo, hi) = distance_to_bones(&side_pos, &bones);
             let mut fold = f64::NAN;
             let mut caps = 0usize;
-            if m.curve {
-                // Skinner is a trait object; the curve diagnostics come from the f64 twin below.
-                if is_key && n_fold > 0 && m.name == "curve" {
-                    cs(curve64.prepare(&sk, &posed))?;
-                    caps = curve64.diagnostics().cap_hits;
-                    fold = fold_fraction(&|x| curve64.map_point(&x), &samples, 1e-5);
+            // Skinner is a trait object; the curve diagnostics come from the f64 twin.
+            if let Some(twin) = m.twin.as_deref_mut() {
+                cs(twin.prepare(&sk, &posed))?;
+                if is_key && n_fold > 0 {
+                    caps = twin.diagnostics().cap_hits;
+                    let tw: &CurveSkin = twin;
+                    fold = fold_fraction(&|x| tw.map_point(&x), &samples, 1e-5);
                 }
             }
             // Self-intersections (surface) only at the key angles: a BVH over every triangle.
@@ -280,17 +368,44 @@ pub fn run_arm(ctx: &RunCtx) -> Result<Summary> {
             if is_key {
                 tagged(&mut summary, &format!("{base}_self_intersections"), si);
             }
-            if m.curve && m.name == "curve" && !fold.is_nan() {
-                tagged(&mut summary, "curve_fold_fraction", fold);
-                tagged(&mut summary, "curve_cap_hits", caps as f64);
+            if m.curve && !fold.is_nan() {
+                tagged(&mut summary, &format!("{base}_fold_fraction"), fold);
+                tagged(&mut summary, &format!("{base}_cap_hits"), caps as f64);
             }
-            if at_summary && m.name == "curve" {
-                cs(curve64.prepare(&sk, &posed))?;
-                let mut o64 = vec![Pt3::origin(); n];
-                curve64.deform_f64(&mut o64);
-                let side64: Vec<Pt3> = o64.iter().zip(&side).filter(|(_, &s)| s).map(|(x, _)| *x).collect();
-                summary.set("curve_max_dist_over_r_f64", distance_to_bones(&side64, &bones).1 / r);
-                summary.set("curve_volume_ratio_f64", signed_volume(&o64, &mesh.tris) / v0);
+            if let Some(twin) = m.twin.as_deref() {
+                if at_summary {
+                    let mut o64 = vec![Pt3::origin(); n];
+                    twin.deform_f64(&mut o64);
+                    let side64: Vec<Pt3> = o64.iter().zip(&side).filter(|(_, &s)| s).map(|(x, _)| *x).collect();
+                    summary.set(&format!("{base}_max_dist_over_r_f64"), distance_to_bones(&side64, &bones).1 / r);
+                    summary.set(&format!("{base}_volume_ratio_f64"), signed_volume(&o64, &mesh.tris) / v0);
+                }
+                if is_key || at_summary {
+                    tagged(&mut summary, &format!("{base}_l_over_r"), twin.frames()[0].l_cp / r);
+                }
+                if let (Some((line, bulge)), "curve") = (&muscle, m.name.as_str()) {
+                    let mut lp = Vec::new();
+                    line.deform(twin, &mut lp);
+                    let ratio = line.length_ratio(&lp);
+                    let mut bulged = out.clone();
+                    bulge.apply(&lp, ratio, &mut bulged);
+                    let vb = signed_volume(&to_f64(&bulged), &mesh.tris) / v0;
+                    tagged(&mut summary, "muscle_length_ratio", ratio);
+                    tagged(&mut summary, "muscle_bulge_volume_ratio", vb);
+                    if let Some(c) = muscle_csv.as_mut() {
+                        c.row(&[deg.into(), ratio.into(), (polyline_length(&lp) / r).into(), vb.into()])?;
+                    }
+                    if is_key {
+                        let name = format!("muscle_{:03}.obj", deg.round() as i64);
+                        write_polyline(&ctx.out_dir.join("obj"), &name, &lp)?;
+                        write_obj(
+                            &ctx.out_dir.join("obj"),
+                            &format!("curve_muscle_{:03}.obj", deg.round() as i64),
+                            &bulged,
+                            &mesh.tris,
+                        )?;
+                    }
+                }
             }
         }
     }
@@ -338,6 +453,9 @@ fn write_arm_report(ctx: &RunCtx, p: &ArmParams, s: &Summary) -> Result<()> {
             (135, "dqs", "0.9999 / 1.000 / 0.002 / 1.107"),
             (135, "curve", "0.8921 / 0.985 / 0.388 / 1.000"),
             (135, "curve_comp", "1.0000 / 1.590 / 0.613 / 1.605"),
+            (45, "curve_bspline", "– (option, not in the prototype table)"),
+            (90, "curve_bspline", "–"),
+            (135, "curve_bspline", "–"),
         ];
         for (deg, m, sp) in spec {
             md.push_str(&format!(
