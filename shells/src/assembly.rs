@@ -9,7 +9,8 @@
 //! the symbolic Cholesky analysis is computed once.
 
 use crate::integrator::DofMap;
-use crate::kernels::bending::bending_eval;
+use crate::kernels::bending::{bending_eval, wrap_angle};
+use crate::kernels::hinge::{hinge_is_collapsed, HingeFrame};
 use crate::kernels::membrane::{membrane_eval, Membrane};
 use crate::kernels::psd::HessianMode;
 use crate::mesh::ShellMesh;
@@ -45,11 +46,17 @@ pub(crate) struct EvalOutput {
 }
 
 /// Buffers, gather lists, the fixed pattern.
+///
+/// Element matrices are stored column-major in `vals` (triangles, then hinges, then the diagonal
+/// mass blocks). Every stored entry `e` of the lower-triangular CSC matrix is the sum of
+/// `vals[gather[k]]` for k in `gather_ptr[e]..gather_ptr[e + 1]`, in the fixed contribution
+/// order of [`FixedPattern`] (precomputed once: no hashing, sorting or intermediate buffer per
+/// step), so the sums are bitwise independent of the thread count.
 pub(crate) struct Assembler {
     pub dofs: DofMap,
-    pattern: FixedPattern,
-    src: Vec<u32>,
-    contrib: Vec<f64>,
+    mat: Csc,
+    gather_ptr: Vec<u32>,
+    gather: Vec<u32>,
     vals: Vec<f64>,
     off_hinge: usize,
     off_diag: usize,
@@ -94,7 +101,8 @@ impl Assembler {
                             let (row, col) = (3 * fa + r, 3 * fb + c);
                             if row >= col {
                                 keys.push((row, col));
-                                src.push((base + (3 * a + r as usize) * nloc + 3 * b + c as usize) as u32);
+                                // Column-major local storage: entry (3a + r, 3b + c).
+                                src.push((base + (3 * b + c as usize) * nloc + 3 * a + r as usize) as u32);
                             }
                         }
                     }
@@ -116,12 +124,33 @@ impl Assembler {
             }
         }
         let pattern = FixedPattern::new(3 * nf, 3 * nf, &keys, true);
+        // Per stored entry, the `vals` indices of its contributions in increasing key order (the
+        // order FixedPattern sums in).
+        let nnz = pattern.nnz();
+        let mut count = vec![0u32; nnz + 1];
+        for k in 0..keys.len() {
+            if let Some(e) = pattern.slot(k) {
+                count[e + 1] += 1;
+            }
+        }
+        for e in 0..nnz {
+            count[e + 1] += count[e];
+        }
+        let gather_ptr = count.clone();
+        let mut gather = vec![0u32; count[nnz] as usize];
+        for (k, &sk) in src.iter().enumerate() {
+            if let Some(e) = pattern.slot(k) {
+                gather[count[e] as usize] = sk;
+                count[e] += 1;
+            }
+        }
+        let mat = pattern.csc().clone();
         let mut block_offset = std::collections::HashMap::new();
         for (t, tri) in mesh.tris.iter().enumerate() {
             for a in 0..3 {
                 for b in 0..3 {
                     if a != b {
-                        block_offset.entry((tri[a], tri[b])).or_insert(t * TRI_VALS + 3 * a * 9 + 3 * b);
+                        block_offset.entry((tri[a], tri[b])).or_insert(t * TRI_VALS + 3 * b * 9 + 3 * a);
                     }
                 }
             }
@@ -158,9 +187,9 @@ impl Assembler {
             }
         }
         Self {
-            contrib: vec![0.0; src.len()],
-            src,
-            pattern,
+            mat,
+            gather_ptr,
+            gather,
             vals: vec![0.0; off_diag + nf * DIAG_VALS],
             off_hinge,
             off_diag,
@@ -185,7 +214,19 @@ impl Assembler {
 
     /// The assembled matrix (lower triangle) as of the last [`Assembler::assemble`].
     pub(crate) fn matrix(&self) -> &Csc {
-        self.pattern.csc()
+        &self.mat
+    }
+
+    /// Sums the element buffers into the matrix (fixed order per entry, parallel over entries).
+    fn gather_matrix(&mut self) {
+        let (ptr, idx, vals) = (&self.gather_ptr, &self.gather, &self.vals);
+        self.mat.val_mut().par_iter_mut().with_min_len(4096).enumerate().for_each(|(e, out)| {
+            let mut s = 0.0;
+            for &k in &idx[ptr[e] as usize..ptr[e + 1] as usize] {
+                s += vals[k as usize];
+            }
+            *out = s;
+        });
     }
 
     /// Evaluates all elements at `inp.q`/`inp.v`, writes element forces (elastic + damping +
@@ -235,7 +276,7 @@ impl Assembler {
                         }
                     }
                 }
-                m.copy_from_slice(mat.transpose().as_slice()); // row-major
+                m.copy_from_slice(mat.as_slice()); // column-major
             });
         // Hinges: bending (+ damping).
         hinge_vals
@@ -247,6 +288,36 @@ impl Assembler {
             .for_each(|(i, (((m, f), e), sk))| {
                 let hg = &mesh.hinges[i];
                 let x = hg.v.map(|v| inp.q[v as usize]);
+                if inp.mode == HessianMode::ProjectedCheap {
+                    // Gauss–Newton only: the matrix (h² + hβ_bend)·2kω∇θ∇θᵀ is rank one, and so
+                    // is its damping force −β_bend·2kω∇θ(∇θ·v); no 12×12 products.
+                    *sk = hinge_is_collapsed(&x);
+                    if *sk {
+                        *e = 0.0;
+                        m.fill(0.0);
+                        f.fill(Vec3::zeros());
+                        return;
+                    }
+                    let fr = HingeFrame::new(&x);
+                    let d = wrap_angle(fr.angle() - hg.rest_theta);
+                    let kw = hg.stiffness * hg.weight;
+                    let g = fr.grad();
+                    *e = kw * d * d;
+                    let gv: f64 = if bb > 0.0 { (0..4).map(|a| g[a].dot(&inp.v[hg.v[a] as usize])).sum() } else { 0.0 };
+                    let fs = -2.0 * kw * (d + bb * gv);
+                    for a in 0..4 {
+                        f[a] = fs * g[a];
+                    }
+                    let c = 2.0 * kw * (h2 + h * bb);
+                    let gl: [f64; 12] = std::array::from_fn(|k| g[k / 3][k % 3]);
+                    for (col, chunk) in m.chunks_exact_mut(12).enumerate() {
+                        let cg = c * gl[col];
+                        for (r, out) in chunk.iter_mut().enumerate() {
+                            *out = cg * gl[r];
+                        }
+                    }
+                    return;
+                }
                 let o = bending_eval(hg, &x, inp.mode, bb > 0.0);
                 *e = o.energy;
                 *sk = o.skipped;
@@ -263,13 +334,13 @@ impl Assembler {
                         }
                     }
                 }
-                m.copy_from_slice(mat.transpose().as_slice());
+                m.copy_from_slice(mat.as_slice());
             });
         // Custom off-diagonal Jacobian blocks, in the order given (deterministic).
         for &(off, m) in &self.custom_offdiag {
             for r in 0..3 {
                 for c in 0..3 {
-                    tri_vals[off + r * 9 + c] += m[(r, c)];
+                    tri_vals[off + c * 9 + r] += m[(r, c)];
                 }
             }
         }
@@ -280,7 +351,7 @@ impl Assembler {
             let v = dofs.free_vertices[fidx] as usize;
             let m = mesh.mass[v] * (1.0 + h * alpha + inp.shift);
             let blk = Mat3::from_diagonal_element(m) + custom[fidx];
-            d.copy_from_slice(blk.transpose().as_slice());
+            d.copy_from_slice(blk.as_slice());
         });
         // Per-vertex force sums in fixed element order.
         let (ptr, idx, ef) = (&self.force_ptr, &self.force_idx, &self.elem_force);
@@ -291,10 +362,8 @@ impl Assembler {
             }
             *out = s;
         });
-        // Matrix: gather then fixed-order sums.
-        let vals = &self.vals;
-        self.contrib.par_iter_mut().zip(self.src.par_iter()).for_each(|(c, &s)| *c = vals[s as usize]);
-        self.pattern.assemble(&self.contrib);
+        // Matrix: fixed-order sums straight from the element buffers.
+        self.gather_matrix();
         EvalOutput {
             skipped_hinges: self.hinge_skipped.iter().filter(|&&s| s).count() as u32,
             collapsed_triangles: self.tri_collapsed.iter().filter(|&&s| s).count() as u32,
@@ -308,10 +377,8 @@ impl Assembler {
             let m = mesh.mass[v] * (1.0 + h_eff * alpha + shift);
             let blk = Mat3::from_diagonal_element(m) + self.custom_diag[fidx];
             let o = self.off_diag + fidx * DIAG_VALS;
-            self.vals[o..o + DIAG_VALS].copy_from_slice(blk.transpose().as_slice());
+            self.vals[o..o + DIAG_VALS].copy_from_slice(blk.as_slice());
         }
-        let vals = &self.vals;
-        self.contrib.par_iter_mut().zip(self.src.par_iter()).for_each(|(c, &s)| *c = vals[s as usize]);
-        self.pattern.assemble(&self.contrib);
+        self.gather_matrix();
     }
 }

@@ -576,6 +576,60 @@ impl ShellSim {
         Ok(st)
     }
 
+    /// Redoes the end of the last (backward Euler) step with other end-of-step velocities:
+    /// free vertices take `v_new` (m/s, one per vertex; pinned and kinematic vertices keep their
+    /// prescribed velocity), the collision pass (§3.9: proximity, CCD, impact zones) runs again
+    /// on the straight motion q_k → q_k + h·v from the step's start q_k, and the state becomes
+    /// (q_k + h·v, v) at the same time t. Used by `tracks` to reproject its constraints after
+    /// collisions (tracks spec §3.7 step 5) while collision-freedom keeps priority. Without
+    /// collision effects only the velocities and positions are replaced.
+    ///
+    /// Errors: `BadParameter` before any step, after a `set_state`, for a BDF2 simulation (its
+    /// end positions are not q_k + h·v), or when `v_new` has the wrong length; `NonFinite` for
+    /// non-finite input; `Diverged` as in [`ShellSim::step`]. On error the state is unchanged.
+    pub fn recollide(&mut self, v_new: &[Vec3]) -> Result<StepStats> {
+        let n = self.mesh.n_vertices();
+        if self.settings.kind == IntegratorKind::Bdf2 {
+            return Err(Error::BadParameter("recollide supports backward Euler only".into()));
+        }
+        let Some((prev, h)) = self.prev.as_ref() else {
+            return Err(Error::BadParameter("recollide needs a previous step".into()));
+        };
+        if v_new.len() != n {
+            return Err(Error::BadParameter(format!("recollide: {} velocities for {n} vertices", v_new.len())));
+        }
+        if v_new.iter().any(|p| p.iter().any(|c| !c.is_finite())) {
+            return Err(Error::NonFinite("recollide velocities"));
+        }
+        let (h, t_next) = (*h, self.state.t);
+        let qk = &prev.q;
+        let mut st = StepStats::default();
+        let mut v: Vec<Vec3> =
+            (0..n).map(|i| if self.inv_mass[i] > 0.0 { v_new[i] } else { self.state.v[i] }).collect();
+        if let Some(col) = self.collider.as_mut() {
+            let tc = Instant::now();
+            col.filter(qk, &mut v, h, t_next, &self.inv_mass, &mut st);
+            st.t_collision = tc.elapsed().as_secs_f64();
+        }
+        let q_new: Vec<Pt3> =
+            (0..n).map(|i| if self.inv_mass[i] > 0.0 { qk[i] + h * v[i] } else { self.state.q[i] }).collect();
+        if q_new.iter().any(|p| p.iter().any(|c| !c.is_finite())) || v.iter().any(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(Error::Diverged { step: self.steps, reason: "non-finite positions or velocities".into() });
+        }
+        let e = self.energies_of(&q_new, &v);
+        let limit = self.settings.divergence_energy_factor * self.energy_ref;
+        if !(e.membrane + e.bending + e.kinetic <= limit) {
+            return Err(Error::Diverged {
+                step: self.steps,
+                reason: format!("energy {:.3e} J above {:.3e} J", e.membrane + e.bending + e.kinetic, limit),
+            });
+        }
+        self.state.q = q_new;
+        self.state.v = v;
+        Ok(st)
+    }
+
     /// Factor with diagonal-shift retries (§3.8) and solve.
     fn solve_system(&mut self, b: &[f64], h_eff: f64, alpha: f64, st: &mut StepStats) -> Result<Vec<f64>> {
         let tf = Instant::now();

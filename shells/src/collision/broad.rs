@@ -1,128 +1,124 @@
-//! Broad phase: a uniform spatial hash of swept, inflated boxes. Candidate pairs come out sorted
-//! and deduplicated, so everything downstream runs in a fixed order (deterministic).
+//! Broad phase (shells.md §3.9): geom-core [`AabbTree`]s over the swept, inflated boxes of the
+//! cloth's vertices, triangles and edges. The trees are built once, refitted on every query (O(n))
+//! and rebuilt every [`REBUILD_EVERY`] steps, when refitted boxes have drifted far from the
+//! build-time layout. Candidate pairs come out sorted and deduplicated, so everything downstream
+//! runs in a fixed order (deterministic for any thread count).
 
-use geom_core::math::Pt3;
-use std::collections::HashMap;
+use geom_core::spatial::{Aabb, AabbTree};
 
-/// Axis-aligned box.
-#[derive(Clone, Copy, Debug)]
-pub struct Bx {
-    /// Minimum corner.
-    pub lo: Pt3,
-    /// Maximum corner.
-    pub hi: Pt3,
-}
-
-impl Bx {
-    /// Box of points grown by `margin`.
-    pub fn of(points: &[Pt3], margin: f64) -> Self {
-        let mut lo = points[0];
-        let mut hi = points[0];
-        for p in &points[1..] {
-            lo = lo.inf(p);
-            hi = hi.sup(p);
-        }
-        let m = geom_core::math::Vec3::repeat(margin);
-        Bx { lo: lo - m, hi: hi + m }
-    }
-
-    /// True when the boxes overlap (closed).
-    pub fn overlaps(&self, o: &Bx) -> bool {
-        (0..3).all(|k| self.lo[k] <= o.hi[k] && o.lo[k] <= self.hi[k])
-    }
-}
-
-/// Spatial hash of boxes.
-pub struct Grid {
-    cell: f64,
-    map: HashMap<(i64, i64, i64), Vec<u32>>,
-}
-
-impl Grid {
-    /// Cell size `cell` (> 0); boxes are inserted with [`Grid::insert`].
-    pub fn new(cell: f64) -> Self {
-        Self { cell, map: HashMap::new() }
-    }
-
-    fn range(&self, b: &Bx) -> ([i64; 3], [i64; 3]) {
-        let f = |x: f64| (x / self.cell).floor() as i64;
-        ([f(b.lo.x), f(b.lo.y), f(b.lo.z)], [f(b.hi.x), f(b.hi.y), f(b.hi.z)])
-    }
-
-    /// Inserts box `id`.
-    pub fn insert(&mut self, id: u32, b: &Bx) {
-        let (lo, hi) = self.range(b);
-        for i in lo[0]..=hi[0] {
-            for j in lo[1]..=hi[1] {
-                for k in lo[2]..=hi[2] {
-                    self.map.entry((i, j, k)).or_default().push(id);
-                }
-            }
-        }
-    }
-
-    /// Calls `f` for every id whose cells the box touches (ids may repeat).
-    pub fn query(&self, b: &Bx, mut f: impl FnMut(u32)) {
-        let (lo, hi) = self.range(b);
-        for i in lo[0]..=hi[0] {
-            for j in lo[1]..=hi[1] {
-                for k in lo[2]..=hi[2] {
-                    if let Some(v) = self.map.get(&(i, j, k)) {
-                        for &id in v {
-                            f(id);
-                        }
-                    }
-                }
-            }
-        }
-    }
-}
+/// Steps between full rebuilds of the trees (refit in between; spec §3.9).
+pub const REBUILD_EVERY: u32 = 50;
 
 /// Sorted index pairs.
 pub type Pairs = Vec<(u32, u32)>;
 
-/// Candidate (vertex, triangle) and (edge, edge) pairs whose boxes overlap, sorted, without
-/// pairs that share a vertex.
-pub fn candidate_pairs(
-    tris: &[[u32; 3]],
-    edges: &[[u32; 2]],
-    vbox: &[Bx],
-    tbox: &[Bx],
-    ebox: &[Bx],
-    cell: f64,
-) -> (Pairs, Pairs) {
-    let mut vt = Vec::new();
-    let mut ee = Vec::new();
-    let mut g = Grid::new(cell);
-    for (t, b) in tbox.iter().enumerate() {
-        g.insert(t as u32, b);
+/// Vertex, triangle and edge trees with their refit/rebuild bookkeeping.
+#[derive(Default)]
+pub struct BroadPhase {
+    trees: Option<[AabbTree; 3]>,
+    steps_since_build: u32,
+}
+
+impl BroadPhase {
+    /// Marks the start of a step: after [`REBUILD_EVERY`] steps the next query rebuilds.
+    pub fn next_step(&mut self) {
+        self.steps_since_build += 1;
+        if self.steps_since_build >= REBUILD_EVERY {
+            self.trees = None;
+        }
     }
-    for (v, b) in vbox.iter().enumerate() {
-        g.query(b, |t| {
-            let tri = tris[t as usize];
-            if !tri.contains(&(v as u32)) && b.overlaps(&tbox[t as usize]) {
-                vt.push((v as u32, t));
+
+    /// True once the trees exist (they are built on the first query).
+    pub fn is_built(&self) -> bool {
+        self.trees.is_some()
+    }
+
+    /// Candidate (vertex, triangle) and (edge, edge) pairs whose boxes overlap, sorted, without
+    /// pairs that share a vertex. `vbox`, `tbox`, `ebox` are the boxes of the vertices, of
+    /// `tris` and of `edges`; their lengths must not change between calls.
+    pub fn candidate_pairs(
+        &mut self,
+        tris: &[[u32; 3]],
+        edges: &[[u32; 2]],
+        vbox: &[Aabb],
+        tbox: &[Aabb],
+        ebox: &[Aabb],
+    ) -> (Pairs, Pairs) {
+        match &mut self.trees {
+            Some([v, t, e]) => {
+                v.refit(vbox);
+                t.refit(tbox);
+                e.refit(ebox);
+            }
+            None => {
+                self.trees = Some([AabbTree::build(vbox), AabbTree::build(tbox), AabbTree::build(ebox)]);
+                self.steps_since_build = 0;
+            }
+        }
+        let [vt_tree, t_tree, e_tree] = self.trees.as_ref().expect("built just above");
+        let mut vt = Vec::new();
+        vt_tree.pairs_with(t_tree, |v, t| {
+            if !tris[t as usize].contains(&v) {
+                vt.push((v, t));
             }
         });
+        vt.sort_unstable();
+        let mut ee = Vec::new();
+        e_tree.self_pairs(|e, f| {
+            let (ea, eb) = (edges[e as usize], edges[f as usize]);
+            if !eb.contains(&ea[0]) && !eb.contains(&ea[1]) {
+                ee.push((e, f));
+            }
+        });
+        ee.sort_unstable();
+        (vt, ee)
     }
-    vt.sort_unstable();
-    vt.dedup();
-    let mut g = Grid::new(cell);
-    for (e, b) in ebox.iter().enumerate() {
-        g.insert(e as u32, b);
-    }
-    for (e, b) in ebox.iter().enumerate() {
-        let ea = edges[e];
-        g.query(b, |f| {
-            if f as usize > e {
-                let eb = edges[f as usize];
-                if !eb.contains(&ea[0]) && !eb.contains(&ea[1]) && b.overlaps(&ebox[f as usize]) {
-                    ee.push((e as u32, f));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geom_core::math::Pt3;
+
+    /// Tree candidates equal the brute-force list of overlapping, non-adjacent pairs, before and
+    /// after a refit with moved boxes.
+    #[test]
+    fn matches_brute_force() {
+        let mut rng = geom_core::rng::Rng::new(7);
+        let n = 60;
+        let mut pts: Vec<Pt3> =
+            (0..n).map(|_| Pt3::new(rng.range(0.0, 1.0), rng.range(0.0, 1.0), rng.range(0.0, 0.3))).collect();
+        let tris: Vec<[u32; 3]> = (0..40).map(|i| [i, (i + 7) % n as u32, (i + 19) % n as u32]).collect();
+        let edges: Vec<[u32; 2]> = (0..50).map(|i| [i, (i + 3) % n as u32]).collect();
+        let mut bp = BroadPhase::default();
+        for round in 0..2 {
+            let vb: Vec<Aabb> = pts.iter().map(|p| Aabb::from_points(&[*p]).grow(0.05)).collect();
+            let tb: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(&t.map(|i| pts[i as usize]))).collect();
+            let eb: Vec<Aabb> = edges.iter().map(|e| Aabb::from_points(&e.map(|i| pts[i as usize]))).collect();
+            let (vt, ee) = bp.candidate_pairs(&tris, &edges, &vb, &tb, &eb);
+            let mut bvt = Vec::new();
+            for (v, b) in vb.iter().enumerate() {
+                for (t, c) in tb.iter().enumerate() {
+                    if b.overlaps(c) && !tris[t].contains(&(v as u32)) {
+                        bvt.push((v as u32, t as u32));
+                    }
                 }
             }
-        });
+            let mut bee = Vec::new();
+            for e in 0..edges.len() {
+                for f in e + 1..edges.len() {
+                    let shared = edges[f].contains(&edges[e][0]) || edges[f].contains(&edges[e][1]);
+                    if !shared && eb[e].overlaps(&eb[f]) {
+                        bee.push((e as u32, f as u32));
+                    }
+                }
+            }
+            assert_eq!(vt, bvt, "round {round}");
+            assert_eq!(ee, bee, "round {round}");
+            assert!(bp.is_built());
+            for p in &mut pts {
+                p.x = 1.0 - p.x * p.x;
+            }
+        }
     }
-    ee.sort_unstable();
-    ee.dedup();
-    (vt, ee)
 }

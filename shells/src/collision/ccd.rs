@@ -2,8 +2,8 @@
 //! the coplanarity cubic ((x₂−x₁)(t) × (x₃−x₁)(t))·(x₄−x₁)(t) = 0 on t ∈ [0, 1], roots by
 //! `geom_core::math::poly::cubic_roots_unit`, then the true distance at each root.
 
-use super::geometry::{closest_point_triangle, closest_points_segments};
 use geom_core::math::{Pt3, Vec3};
+use geom_core::query::{closest_point_triangle, closest_points_segments};
 
 pub use geom_core::math::poly::cubic_roots_unit;
 

@@ -24,10 +24,12 @@ pub mod obstacles;
 use crate::effects::{CollisionSettings, Effects, Obstacle};
 use crate::integrator::StepStats;
 use crate::mesh::ShellMesh;
-use broad::{candidate_pairs, Bx};
+use broad::BroadPhase;
 use geom_core::graph::UnionFind;
 use geom_core::math::{Mat3, Pt3, Vec3};
-use geometry::{closest_point_triangle, closest_points_segments, safe_normal};
+use geom_core::query::{closest_point_triangle, closest_points_segments};
+use geom_core::spatial::Aabb;
+use geometry::safe_normal;
 use obstacles::PlacedObstacle;
 use rayon::prelude::*;
 
@@ -68,8 +70,10 @@ pub(crate) struct Collider {
     delta_ccd: f64,
     self_collision: bool,
     obstacles: Vec<Obstacle>,
+    /// Query structures of closed mesh obstacles (`None` for the others), built once.
+    obstacle_accel: Vec<Option<geom_core::collide::MeshQuery>>,
     thin: f64,
-    cell: f64,
+    broad: BroadPhase,
 }
 
 impl Collider {
@@ -88,8 +92,9 @@ impl Collider {
             delta_ccd: 1e-6 * l,
             self_collision: effects.self_collision,
             obstacles: effects.obstacles.clone(),
+            obstacle_accel: effects.obstacles.iter().map(obstacles::mesh_query).collect(),
             thin: 2.0 * mean_edge,
-            cell: (2.0 * mean_edge).max(4.0 * h_c).max(1e-6),
+            broad: BroadPhase::default(),
         }
     }
 
@@ -100,6 +105,7 @@ impl Collider {
         if n == 0 {
             return;
         }
+        self.broad.next_step();
         if self.self_collision {
             self.proximity(q, v, h, im, st);
         }
@@ -132,71 +138,65 @@ impl Collider {
         }
     }
 
-    /// Swept, inflated boxes of vertices, triangles and edges.
-    fn boxes(&self, q: &[Pt3], v: &[Vec3], h: f64, margin: f64) -> (Vec<Bx>, Vec<Bx>, Vec<Bx>) {
-        let end: Vec<Pt3> = q.iter().zip(v).map(|(p, w)| p + h * w).collect();
-        let vb: Vec<Bx> = (0..q.len()).into_par_iter().map(|i| Bx::of(&[q[i], end[i]], margin)).collect();
-        let tb: Vec<Bx> = self
-            .tris
-            .par_iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| i as usize);
-                Bx::of(&[q[a], q[b], q[c], end[a], end[b], end[c]], margin)
-            })
-            .collect();
-        let eb: Vec<Bx> = self
-            .edges
-            .par_iter()
-            .map(|e| {
-                let [a, b] = e.map(|i| i as usize);
-                Bx::of(&[q[a], q[b], end[a], end[b]], margin)
-            })
-            .collect();
-        (vb, tb, eb)
+    /// Candidate (vertex, triangle) and (edge, edge) pairs for the motion q → q + h v: swept
+    /// boxes inflated by `margin`, through the refitted trees of the broad phase.
+    fn candidates(&mut self, q: &[Pt3], v: Option<&[Vec3]>, h: f64, margin: f64) -> (broad::Pairs, broad::Pairs) {
+        // Vertex boxes first; triangle and edge boxes are unions of their vertices' boxes.
+        let vb: Vec<Aabb> = match v {
+            Some(v) => q.iter().zip(v).map(|(p, w)| Aabb::from_points(&[*p, p + h * w]).grow(margin)).collect(),
+            None => q.iter().map(|p| Aabb::from_points(&[*p]).grow(margin)).collect(),
+        };
+        let tb: Vec<Aabb> =
+            self.tris.iter().map(|t| vb[t[0] as usize].union(&vb[t[1] as usize]).union(&vb[t[2] as usize])).collect();
+        let eb: Vec<Aabb> = self.edges.iter().map(|e| vb[e[0] as usize].union(&vb[e[1] as usize])).collect();
+        self.broad.candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb)
     }
 
     /// Step 1: proximity at q with inelastic + repulsion impulses and friction.
-    fn proximity(&self, q: &[Pt3], v: &mut [Vec3], h: f64, im: &[f64], st: &mut StepStats) {
+    fn proximity(&mut self, q: &[Pt3], v: &mut [Vec3], h: f64, im: &[f64], st: &mut StepStats) {
         let hc = self.h_c;
-        let zero = vec![Vec3::zeros(); q.len()];
-        let (vb, tb, eb) = self.boxes(q, &zero, h, hc);
-        let (vt, ee) = candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb, self.cell);
-        let mut stencils: Vec<(Stencil, f64)> = Vec::new();
-        for &(p, t) in &vt {
+        // Boxes grown by h_c/2 each overlap exactly when the points may be closer than h_c.
+        let (vt, ee) = self.candidates(q, None, h, 0.5 * hc);
+        // Narrow phase in parallel; `collect` keeps the sorted pair order (deterministic).
+        let vel: &[Vec3] = v;
+        let mut stencils: Vec<(Stencil, f64)> = par_filter_map(&vt, |&(p, t)| {
             let tri = self.tris[t as usize];
             let x = tri.map(|i| q[i as usize]);
             let (c, w) = closest_point_triangle(&q[p as usize], &x);
             let d = (q[p as usize] - c).norm();
-            if d < hc {
-                let tn = (x[1] - x[0]).cross(&(x[2] - x[0]));
-                let nrm = if d > 1e-12 * hc {
-                    (q[p as usize] - c) / d
-                } else {
-                    // Coincident: the triangle normal, on the vertex's side of motion.
-                    let n0 = safe_normal(&(x[1] - x[0]), &(x[2] - x[0]));
-                    if tn.dot(&(v[p as usize])) > 0.0 {
-                        -n0
-                    } else {
-                        n0
-                    }
-                };
-                stencils.push((Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm }, d));
+            if d >= hc {
+                return None;
             }
-        }
-        for &(e, f) in &ee {
+            let tn = (x[1] - x[0]).cross(&(x[2] - x[0]));
+            let nrm = if d > 1e-12 * hc {
+                (q[p as usize] - c) / d
+            } else {
+                // Coincident: the triangle normal, on the vertex's side of motion.
+                let n0 = safe_normal(&(x[1] - x[0]), &(x[2] - x[0]));
+                if tn.dot(&(vel[p as usize])) > 0.0 {
+                    -n0
+                } else {
+                    n0
+                }
+            };
+            Some((Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm }, d))
+        });
+        let ee_st: Vec<(Stencil, f64)> = par_filter_map(&ee, |&(e, f)| {
             let (a, b) = (self.edges[e as usize], self.edges[f as usize]);
             let (s, u, pa, pb) =
                 closest_points_segments(&q[a[0] as usize], &q[a[1] as usize], &q[b[0] as usize], &q[b[1] as usize]);
             let d = (pa - pb).norm();
-            if d < hc {
-                let nrm = if d > 1e-12 * hc {
-                    (pa - pb) / d
-                } else {
-                    safe_normal(&(q[a[1] as usize] - q[a[0] as usize]), &(q[b[1] as usize] - q[b[0] as usize]))
-                };
-                stencils.push((Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm }, d));
+            if d >= hc {
+                return None;
             }
-        }
+            let nrm = if d > 1e-12 * hc {
+                (pa - pb) / d
+            } else {
+                safe_normal(&(q[a[1] as usize] - q[a[0] as usize]), &(q[b[1] as usize] - q[b[0] as usize]))
+            };
+            Some((Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm }, d))
+        });
+        stencils.extend(ee_st);
         st.n_proximity += stencils.len() as u32;
         let fsep = self.settings.separation_speed_frac;
         let reqs: Vec<Request> = stencils
@@ -228,8 +228,8 @@ impl Collider {
         }
         let hc = self.h_c;
         let fsep = self.settings.separation_speed_frac;
-        for o in &self.obstacles {
-            let po = PlacedObstacle::new(o, t_next, h);
+        for (o, accel) in self.obstacles.iter().zip(&self.obstacle_accel) {
+            let po = PlacedObstacle::new(o, t_next, h).with_accel(accel.as_ref());
             // Vertices (each independent: obstacle impulses go entirely to the cloth).
             let hits: Vec<(usize, Vec3)> = (0..q.len())
                 .into_par_iter()
@@ -305,67 +305,78 @@ impl Collider {
     }
 
     /// All CCD hits of the motion q → q + h v, as stencils with separating normals.
-    fn ccd_hits(&self, q: &[Pt3], v: &[Vec3], h: f64) -> Vec<Stencil> {
+    fn ccd_hits(&mut self, q: &[Pt3], v: &[Vec3], h: f64) -> Vec<Stencil> {
         let delta = self.delta_ccd;
-        let (vb, tb, eb) = self.boxes(q, v, h, delta);
-        let (vt, ee) = candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb, self.cell);
+        let (vt, ee) = self.candidates(q, Some(v), h, delta);
         let dv = |i: u32| h * v[i as usize];
-        let mut hits: Vec<Stencil> = vt
-            .par_iter()
-            .filter_map(|&(p, t)| {
-                let tri = self.tris[t as usize];
-                let x = tri.map(|i| q[i as usize]);
-                let d = tri.map(dv);
-                let (tc, w) = ccd::vertex_triangle(&q[p as usize], &dv(p), &x, &d, delta)?;
-                let xt: [Pt3; 3] = std::array::from_fn(|k| x[k] + tc * d[k]);
-                let mut nrm = safe_normal(&(xt[1] - xt[0]), &(xt[2] - xt[0]));
-                // Orient from the triangle toward the vertex's starting side.
-                let (c0, _) = closest_point_triangle(&q[p as usize], &x);
-                let side = (q[p as usize] - c0).dot(&nrm);
-                let rel = dv(p) - (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]);
-                if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
-                    nrm = -nrm;
-                }
-                Some(Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm })
-            })
-            .collect();
-        let ee_hits: Vec<Stencil> = ee
-            .par_iter()
-            .filter_map(|&(e, f)| {
-                let (a, b) = (self.edges[e as usize], self.edges[f as usize]);
-                let xa = [q[a[0] as usize], q[a[1] as usize]];
-                let xb = [q[b[0] as usize], q[b[1] as usize]];
-                let da = [dv(a[0]), dv(a[1])];
-                let db = [dv(b[0]), dv(b[1])];
-                let (tc, s, u) = ccd::edge_edge(&xa, &da, &xb, &db, delta)?;
-                let ya: [Pt3; 2] = std::array::from_fn(|k| xa[k] + tc * da[k]);
-                let yb: [Pt3; 2] = std::array::from_fn(|k| xb[k] + tc * db[k]);
-                let mut nrm = safe_normal(&(ya[1] - ya[0]), &(yb[1] - yb[0]));
-                let (_, _, p0, q0) = closest_points_segments(&xa[0], &xa[1], &xb[0], &xb[1]);
-                let side = (p0 - q0).dot(&nrm);
-                let rel = (1.0 - s) * da[0] + s * da[1] - (1.0 - u) * db[0] - u * db[1];
-                if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
-                    nrm = -nrm;
-                }
-                Some(Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm })
-            })
-            .collect();
+        let mut hits: Vec<Stencil> = par_filter_map(&vt, |&(p, t)| {
+            let tri = self.tris[t as usize];
+            let x = tri.map(|i| q[i as usize]);
+            let d = tri.map(dv);
+            let (tc, w) = ccd::vertex_triangle(&q[p as usize], &dv(p), &x, &d, delta)?;
+            let xt: [Pt3; 3] = std::array::from_fn(|k| x[k] + tc * d[k]);
+            let mut nrm = safe_normal(&(xt[1] - xt[0]), &(xt[2] - xt[0]));
+            // Orient from the triangle toward the vertex's starting side.
+            let (c0, _) = closest_point_triangle(&q[p as usize], &x);
+            let side = (q[p as usize] - c0).dot(&nrm);
+            let rel = dv(p) - (w[0] * d[0] + w[1] * d[1] + w[2] * d[2]);
+            if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
+                nrm = -nrm;
+            }
+            Some(Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm })
+        });
+        let ee_hits: Vec<Stencil> = par_filter_map(&ee, |&(e, f)| {
+            let (a, b) = (self.edges[e as usize], self.edges[f as usize]);
+            let xa = [q[a[0] as usize], q[a[1] as usize]];
+            let xb = [q[b[0] as usize], q[b[1] as usize]];
+            let da = [dv(a[0]), dv(a[1])];
+            let db = [dv(b[0]), dv(b[1])];
+            let (tc, s, u) = ccd::edge_edge(&xa, &da, &xb, &db, delta)?;
+            let ya: [Pt3; 2] = std::array::from_fn(|k| xa[k] + tc * da[k]);
+            let yb: [Pt3; 2] = std::array::from_fn(|k| xb[k] + tc * db[k]);
+            let mut nrm = safe_normal(&(ya[1] - ya[0]), &(yb[1] - yb[0]));
+            let (_, _, p0, q0) = closest_points_segments(&xa[0], &xa[1], &xb[0], &xb[1]);
+            let side = (p0 - q0).dot(&nrm);
+            let rel = (1.0 - s) * da[0] + s * da[1] - (1.0 - u) * db[0] - u * db[1];
+            if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
+                nrm = -nrm;
+            }
+            Some(Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm })
+        });
         hits.extend(ee_hits);
         hits
     }
 
     /// Step 4: rigid impact zones, then freezing as the failsafe.
-    fn impact_zones(&self, q: &[Pt3], v: &mut [Vec3], h: f64, im: &[f64], mut hits: Vec<Stencil>, st: &mut StepStats) {
+    fn impact_zones(
+        &mut self,
+        q: &[Pt3],
+        v: &mut [Vec3],
+        h: f64,
+        im: &[f64],
+        mut hits: Vec<Stencil>,
+        st: &mut StepStats,
+    ) {
         let n = q.len();
         let mut uf = UnionFind::new(n);
         let mut in_zone = vec![false; n];
         for _ in 0..self.settings.impact_zone_iters.max(1) {
+            // Only the vertices that take part in the contact (weight ≠ 0) join the zone: a
+            // vertex–triangle hit at an edge or corner of the triangle does not drag the
+            // triangle's third vertex (and everything it is connected to) into the zone.
             for s in &hits {
-                for k in 1..4 {
-                    uf.union(s.v[0], s.v[k]);
-                }
-                for &x in &s.v {
-                    in_zone[x as usize] = true;
+                let mut first = None;
+                for k in 0..4 {
+                    if s.c[k] == 0.0 {
+                        continue;
+                    }
+                    in_zone[s.v[k] as usize] = true;
+                    match first {
+                        None => first = Some(s.v[k]),
+                        Some(f) => {
+                            uf.union(f, s.v[k]);
+                        }
+                    }
                 }
             }
             self.rigidify(q, v, im, &mut uf, &in_zone, st);
@@ -452,6 +463,21 @@ impl Collider {
     }
 }
 
+/// Below this many pairs a narrow phase runs on the calling thread: a few thousand
+/// closest-point or cubic tests take well under a millisecond, less than a fork-join costs on a
+/// loaded machine.
+const PAR_MIN_PAIRS: usize = 8192;
+
+/// `filter_map` over `items`, in parallel for long lists; the output keeps the input order
+/// either way (deterministic).
+fn par_filter_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> Option<R> + Sync + Send) -> Vec<R> {
+    if items.len() < PAR_MIN_PAIRS {
+        items.iter().filter_map(f).collect()
+    } else {
+        items.par_iter().filter_map(f).collect()
+    }
+}
+
 /// Pseudo-inverse of a symmetric PSD 3×3 matrix (eigenvalues below 1e-12·max dropped).
 fn pinv3(m: &Mat3) -> Mat3 {
     let e = nalgebra::SymmetricEigen::new(*m);
@@ -508,72 +534,36 @@ fn apply(reqs: &[Request], v: &mut [Vec3], im: &[f64], n: usize) {
     }
 }
 
-/// Number of intersecting pairs of non-adjacent triangles (shared vertex ⇒ adjacent), with a
-/// floating-point Möller-style test; used for the `max_intersections` figure.
+/// Number of intersecting pairs of non-adjacent triangles (shared vertex ⇒ adjacent), for the
+/// `max_intersections` figure: geom-core's AABB-tree broad phase and exact triangle–triangle
+/// predicates ([`geom_core::query::count_self_intersections`]; touching counts).
 pub fn count_self_intersections(q: &[Pt3], tris: &[[u32; 3]]) -> usize {
-    if tris.is_empty() {
-        return 0;
-    }
-    let boxes: Vec<Bx> = tris.iter().map(|t| Bx::of(&t.map(|i| q[i as usize]), 0.0)).collect();
-    let mean = boxes.iter().map(|b| (b.hi - b.lo).norm()).sum::<f64>() / boxes.len() as f64;
-    let mut g = broad::Grid::new(mean.max(1e-9));
-    for (i, b) in boxes.iter().enumerate() {
-        g.insert(i as u32, b);
-    }
-    let mut pairs = Vec::new();
-    for (i, b) in boxes.iter().enumerate() {
-        g.query(b, |j| {
-            let j = j as usize;
-            if j > i && b.overlaps(&boxes[j]) && !tris[i].iter().any(|v| tris[j].contains(v)) {
-                pairs.push((i, j));
-            }
-        });
-    }
-    pairs.sort_unstable();
-    pairs.dedup();
-    pairs
-        .par_iter()
-        .filter(|&&(i, j)| {
-            let a = tris[i].map(|k| q[k as usize]);
-            let b = tris[j].map(|k| q[k as usize]);
-            tri_tri_intersect(&a, &b)
-        })
-        .count()
+    geom_core::query::count_self_intersections(tris, q)
 }
 
-/// Triangle–triangle intersection (segment–triangle crossing tests in both directions); touching
-/// configurations within round-off may go either way.
-pub fn tri_tri_intersect(a: &[Pt3; 3], b: &[Pt3; 3]) -> bool {
-    (0..3).any(|k| seg_tri(&a[k], &a[(k + 1) % 3], b)) || (0..3).any(|k| seg_tri(&b[k], &b[(k + 1) % 3], a))
-}
-
-fn seg_tri(p: &Pt3, q: &Pt3, t: &[Pt3; 3]) -> bool {
-    let n = (t[1] - t[0]).cross(&(t[2] - t[0]));
-    let dp = n.dot(&(p - t[0]));
-    let dq = n.dot(&(q - t[0]));
-    if (dp > 0.0 && dq > 0.0) || (dp < 0.0 && dq < 0.0) || dp == dq {
-        return false;
-    }
-    let s = dp / (dp - dq);
-    let x = p + s * (q - p);
-    let e = |i: usize| (t[(i + 1) % 3] - t[i]).cross(&(x - t[i])).dot(&n);
-    let (e0, e1, e2) = (e(0), e(1), e(2));
-    (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0)
-}
+/// Exact triangle–triangle intersection test (touching counts), from geom-core.
+pub use geom_core::query::tri_tri_intersect;
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    /// Two crossing triangles count once; sharing a vertex makes them adjacent (not counted).
     #[test]
-    fn tri_tri_basic() {
-        let a = [Pt3::new(0.0, 0.0, 0.0), Pt3::new(1.0, 0.0, 0.0), Pt3::new(0.0, 1.0, 0.0)];
-        let b = [Pt3::new(0.2, 0.2, -1.0), Pt3::new(0.2, 0.2, 1.0), Pt3::new(0.3, 0.5, 0.0)];
-        assert!(tri_tri_intersect(&a, &b));
-        let c = b.map(|p| p + Vec3::new(5.0, 0.0, 0.0));
-        assert!(!tri_tri_intersect(&a, &c));
-        let d = a.map(|p| p + Vec3::new(0.0, 0.0, 0.1));
-        assert!(!tri_tri_intersect(&a, &d));
+    fn counts_crossing_pairs() {
+        let q = vec![
+            Pt3::new(0.0, 0.0, 0.0),
+            Pt3::new(1.0, 0.0, 0.0),
+            Pt3::new(0.0, 1.0, 0.0),
+            Pt3::new(0.2, 0.2, -1.0),
+            Pt3::new(0.2, 0.2, 1.0),
+            Pt3::new(0.3, 0.5, 0.0),
+        ];
+        assert_eq!(count_self_intersections(&q, &[[0, 1, 2], [3, 4, 5]]), 1);
+        assert_eq!(count_self_intersections(&q, &[[0, 1, 2], [0, 4, 5]]), 0);
+        let far: Vec<Pt3> =
+            q.iter().enumerate().map(|(i, p)| if i >= 3 { p + Vec3::new(5.0, 0.0, 0.0) } else { *p }).collect();
+        assert_eq!(count_self_intersections(&far, &[[0, 1, 2], [3, 4, 5]]), 0);
     }
 
     /// Equal-and-opposite impulses: Jacobi application conserves momentum.

@@ -194,23 +194,42 @@ pub fn membrane_eval(
             let e = Vec3::new(g[(0, 0)], g[(1, 1)], 2.0 * g[(0, 1)]);
             let sv = c * e;
             let s = Mat2::new(sv.x, sv.z, sv.z, sv.y);
-            let d: [Mat3; 3] = std::array::from_fn(|a| {
+            // Rows r0, r1, r2 of D_a. With ℂ = stretch block (rows/cols 1–2) + shear entry c₂₂ +
+            // couplings c₀₂, c₁₂: D_aᵀℂD_b = r0_a u_bᵀ + r1_a w_bᵀ + r2_a z_bᵀ + couplings, where
+            // u_b = c₀₀r0_b + c₀₁r1_b, w_b = c₁₀r0_b + c₁₁r1_b, z_b = c₂₂r2_b. Only blocks a ≤ b
+            // are formed (the matrix is symmetric); the damping blocks reuse the same parts.
+            let rows: [[Vec3; 3]; 3] = std::array::from_fn(|a| {
                 let (b1, b2) = (b[a].x, b[a].y);
-                Mat3::from_rows(&[(b1 * f1).transpose(), (b2 * f2).transpose(), (b1 * f2 + b2 * f1).transpose()])
+                [b1 * f1, b2 * f2, b1 * f2 + b2 * f1]
             });
-            let mut cs = *c;
-            for k in 0..3 {
-                cs[(2, k)] = 0.0;
-                cs[(k, 2)] = 0.0;
-            }
+            let coupled = c[(0, 2)] != 0.0 || c[(1, 2)] != 0.0;
+            let uwz: [[Vec3; 3]; 3] = std::array::from_fn(|a| {
+                let [r0, r1, r2] = rows[a];
+                [c[(0, 0)] * r0 + c[(0, 1)] * r1, c[(1, 0)] * r0 + c[(1, 1)] * r1, c[(2, 2)] * r2]
+            });
             for a in 0..3 {
-                for bb in 0..3 {
-                    let blk = area * d[a].transpose() * c * d[bb];
+                for bb in a..3 {
+                    let [r0, r1, r2] = rows[a];
+                    let [u, w, z] = uwz[bb];
+                    let st = area * (r0 * u.transpose() + r1 * w.transpose());
+                    let sh = area * (r2 * z.transpose());
+                    let mut blk = st + sh;
+                    if coupled {
+                        let [q0, q1, q2] = rows[bb];
+                        blk += area
+                            * (c[(0, 2)] * (r0 * q2.transpose() + r2 * q0.transpose())
+                                + c[(1, 2)] * (r1 * q2.transpose() + r2 * q1.transpose()));
+                    }
                     hmat.fixed_view_mut::<3, 3>(3 * a, 3 * bb).copy_from(&blk);
+                    if bb != a {
+                        hmat.fixed_view_mut::<3, 3>(3 * bb, 3 * a).copy_from(&blk.transpose());
+                    }
                     if let (Some(hd), Some((bs, bsh))) = (hdamp.as_mut(), damp) {
-                        let st = area * d[a].transpose() * cs * d[bb];
-                        let sh = area * c[(2, 2)] * d[a].row(2).transpose() * d[bb].row(2);
-                        hd.fixed_view_mut::<3, 3>(3 * a, 3 * bb).copy_from(&(bs * st + bsh * sh));
+                        let dblk = bs * st + bsh * sh;
+                        hd.fixed_view_mut::<3, 3>(3 * a, 3 * bb).copy_from(&dblk);
+                        if bb != a {
+                            hd.fixed_view_mut::<3, 3>(3 * bb, 3 * a).copy_from(&dblk.transpose());
+                        }
                     }
                 }
             }
