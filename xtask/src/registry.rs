@@ -56,6 +56,7 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::geom_core::register(&mut v);
     crate::scenes::barnet::register(&mut v);
     crate::scenes::shells::register(&mut v);
+    crate::scenes::tracks::register(&mut v);
     crate::scenes::curve_skin::register(&mut v);
     v
 }
@@ -82,6 +83,11 @@ pub fn benches() -> Vec<Bench> {
             crate_name: "shells",
             description: "substeps × Newton iterations × Hessian mode on drape and wind-flag: error vs ms/frame",
             run: crate::bench_shells::run,
+        },
+        Bench {
+            crate_name: "tracks",
+            description: "tracks: 16 … 1024 clustered regions on the Xavier clip, deviation and wavelength vs time per frame",
+            run: crate::bench_tracks::run,
         },
     ]
 }

@@ -4,3 +4,4 @@ pub mod barnet;
 pub mod curve_skin;
 pub mod geom_core;
 pub mod shells;
+pub mod tracks;

@@ -1,0 +1,512 @@
+//! The saddle-point solve of the constrained implicit Euler step (spec §3.6):
+//!
+//! ```text
+//! [ A   Ĉᵀ ] [ Δv ]   [ b ]        Ĉ = C_f ⊗ I₃,  r = c·(C̄ q̄(t_{k+1}) − C q⁰) / h_eff
+//! [ Ĉ   0  ] [ μ  ] = [ r ]
+//! ```
+//!
+//! with A, b, q⁰ = q_pred and h_eff exactly the `shells` system ([`shells::ImplicitSystem`]),
+//! so g(q⁰ + h_eff Δv) = 0 to solver precision after one Newton step (g is linear). μ = −hλ of
+//! the seed; the constraint force is f_c = −Ĉᵀμ/h. Methods: constraint-last LDLᵀ (default),
+//! AMD-ordered regularised LDLᵀ with refinement, Schur complement through the LLᵀ of A, penalty,
+//! and compliant (soft) constraints.
+
+use std::time::Instant;
+
+use faer::sparse::{SparseColMat, SymbolicSparseColMat};
+use faer::Mat;
+use geom_core::linalg::{dense, Csc, Csr, LltSymbolic, Ordering, Regularization, SparseLdlt, SparseLlt, Triplets};
+use geom_core::math::{Pt3, Vec3};
+use geom_core::NONE;
+use shells::{ImplicitSystem, VelocitySolve};
+
+use crate::constraints::TrackingConstraints;
+use crate::guide::GuideAnimation;
+
+/// Saddle-point solver (spec §3.6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Deserialize, serde::Serialize)]
+pub enum KktMethod {
+    /// A-block in the AMD order of the untracked LLᵀ, multipliers last, LDLᵀ with sign guard.
+    #[default]
+    ConstraintLastLdlt,
+    /// AMD on the whole KKT pattern, (2,2) block −δ·max diag(A)·I, refinement on the exact KKT.
+    AmdRegularizedLdlt {
+        /// Quasi-definite shift relative to max diag(A) (default 1e-8).
+        delta: f64,
+    },
+    /// Schur complement S = ĈA⁻¹Ĉᵀ (dense) through the LLᵀ of A with the untracked analysis.
+    Schur,
+    /// The Schur system S μ = ĈA⁻¹b − r solved by preconditioned CG, each iteration one LLᵀ solve,
+    /// preconditioned with the dense Cholesky of an S computed exactly at an earlier step (lagged);
+    /// S is recomputed (3K solves) when CG needs more than `refresh_iters` iterations. Exact to
+    /// the CG tolerance (1e-10 relative); per step: the untracked LLᵀ plus 1 + (CG iterations)
+    /// solves. Our addition: faer's LDLᵀ costs ~2× its LLᵀ on these matrices (measured).
+    SchurPcg {
+        /// Recompute S when CG takes more iterations than this.
+        refresh_iters: u32,
+    },
+    /// (A + k_p ĈᵀĈ)Δv = b + k_p Ĉᵀr with LLᵀ (residual ∝ 1/k_p; comparison only).
+    Penalty {
+        /// k_p (kg).
+        stiffness: f64,
+    },
+    /// Soft constraints: (2,2) block −εI, no refinement (violation = ε·μ).
+    Compliant {
+        /// ε (1/kg).
+        compliance: f64,
+    },
+}
+
+/// What the last solve did.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct KktStats {
+    /// Wall time of the constrained solve (assembly of the KKT values, factorisation, solve) (s).
+    pub t_kkt: f64,
+    /// Wall time of the unused shadow LLᵀ of A (s), 0 unless shadow timing is on.
+    pub t_shadow_llt: f64,
+    /// max_i ‖g_i(q⁰ + h_eff Δv)‖ (m): the constraint residual before collisions.
+    pub residual_pre: f64,
+    /// Largest per-vertex constraint force ‖f_c‖ = ‖Ĉᵀμ‖/h (N).
+    pub max_constraint_force: f64,
+    /// Relative residual of the linear KKT solve after refinement.
+    pub refinement_residual: f64,
+    /// The guide was sampled past its end (held).
+    pub guide_held: bool,
+    /// Stored entries of the factor (LDLᵀ or LLᵀ).
+    pub nnz_l: usize,
+}
+
+struct KktCache {
+    n: usize,
+    m: usize,
+    exact: Csc,
+    factor_mat: Option<Csc>,
+    a_map: Vec<usize>,
+    ldlt: SparseLdlt,
+}
+
+/// The constrained velocity solve, plugged into [`shells::ShellSim::step_with`].
+pub struct TrackingSolver {
+    cons: TrackingConstraints,
+    guide: GuideAnimation,
+    method: KktMethod,
+    refine_steps: u32,
+    correction_fraction: f64,
+    shadow: bool,
+    a_perm: Vec<usize>,
+    a_symbolic: LltSymbolic,
+    /// Per free vertex: (constraint, weight) of C_f, built at the first solve.
+    cft: Option<Vec<Vec<(u32, f64)>>>,
+    kkt: Option<KktCache>,
+    llt: Option<SparseLlt>,
+    shadow_llt: Option<SparseLlt>,
+    penalty_symbolic: Option<LltSymbolic>,
+    /// Lagged dense Cholesky of S (SchurPcg) and whether to refresh it at the next step.
+    lagged_s: Option<dense::DenseLlt>,
+    refresh_s: bool,
+    gbuf: Vec<Pt3>,
+    /// Statistics of the last solve.
+    pub last: KktStats,
+}
+
+fn core(e: geom_core::Error) -> shells::Error {
+    shells::Error::Core(e)
+}
+
+impl TrackingSolver {
+    /// A solver for the constraints `cons` (already restricted to rows with free support).
+    /// `a_perm` and `a_symbolic` are the untracked system's AMD order and symbolic analysis
+    /// (`ShellSim::fill_reducing_perm`, `ShellSim::llt_symbolic`), reused by every method.
+    pub fn new(
+        cons: TrackingConstraints,
+        guide: GuideAnimation,
+        opts: &crate::tracker::TrackOptions,
+        a_perm: Vec<usize>,
+        a_symbolic: LltSymbolic,
+    ) -> Self {
+        let nb = guide.n_vertices();
+        Self {
+            cons,
+            guide,
+            method: opts.kkt,
+            refine_steps: opts.refine_steps,
+            correction_fraction: opts.correction_fraction,
+            shadow: opts.shadow_timing,
+            a_perm,
+            a_symbolic,
+            cft: None,
+            kkt: None,
+            llt: None,
+            shadow_llt: None,
+            penalty_symbolic: None,
+            lagged_s: None,
+            refresh_s: true,
+            gbuf: vec![Pt3::origin(); nb],
+            last: KktStats::default(),
+        }
+    }
+
+    /// The constraints this solver enforces.
+    pub fn constraints(&self) -> &TrackingConstraints {
+        &self.cons
+    }
+
+    /// The method.
+    pub fn method(&self) -> KktMethod {
+        self.method
+    }
+
+    fn build_cft(&mut self, sys: &ImplicitSystem) {
+        if self.cft.is_some() {
+            return;
+        }
+        let nf = sys.dofs.n_free();
+        let mut cft: Vec<Vec<(u32, f64)>> = vec![Vec::new(); nf];
+        for i in 0..self.cons.len() {
+            let (c, v) = self.cons.c.row(i);
+            for (&l, &w) in c.iter().zip(v) {
+                let f = sys.dofs.free_index[l as usize];
+                if f != NONE {
+                    cft[f as usize].push((i as u32, w));
+                }
+            }
+        }
+        self.cft = Some(cft);
+    }
+
+    /// Ĉ x for x of length 3 n_free → length 3K.
+    fn c_mul(&self, x: &[f64], out: &mut [f64]) {
+        out.iter_mut().for_each(|o| *o = 0.0);
+        let cft = self.cft.as_ref().expect("built before use");
+        for (f, row) in cft.iter().enumerate() {
+            for &(i, w) in row {
+                for d in 0..3 {
+                    out[3 * i as usize + d] += w * x[3 * f + d];
+                }
+            }
+        }
+    }
+
+    /// Ĉᵀ μ → length 3 n_free.
+    fn ct_mul(&self, mu: &[f64], out: &mut [f64]) {
+        let cft = self.cft.as_ref().expect("built before use");
+        for (f, row) in cft.iter().enumerate() {
+            for d in 0..3 {
+                out[3 * f + d] = row.iter().map(|&(i, w)| w * mu[3 * i as usize + d]).sum();
+            }
+        }
+    }
+
+    fn build_kkt(&mut self, a: &Csc) -> shells::Result<()> {
+        let n = a.nrows();
+        let m = 3 * self.cons.len();
+        let cft = self.cft.as_ref().expect("built before use");
+        let sa = a.symbolic();
+        let mut col_ptr = Vec::with_capacity(n + m + 1);
+        let mut row_idx = Vec::new();
+        let mut a_map = vec![0usize; a.val().len()];
+        col_ptr.push(0);
+        for j in 0..n {
+            for k in sa.col_range(j) {
+                a_map[k] = row_idx.len();
+                row_idx.push(sa.row_idx()[k]);
+            }
+            for &(i, _) in &cft[j / 3] {
+                row_idx.push(n + 3 * i as usize + j % 3);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        for r in 0..m {
+            row_idx.push(n + r);
+            col_ptr.push(row_idx.len());
+        }
+        let mut val = vec![0.0; row_idx.len()];
+        for j in 0..n {
+            let start = col_ptr[j] + sa.col_range(j).len();
+            for (k, &(_, w)) in cft[j / 3].iter().enumerate() {
+                val[start + k] = w;
+            }
+        }
+        let sym = SymbolicSparseColMat::new_checked(n + m, n + m, col_ptr, None, row_idx);
+        let exact: Csc = SparseColMat::new(sym, val);
+        let ordering = match self.method {
+            KktMethod::ConstraintLastLdlt => {
+                let mut p = self.a_perm.clone();
+                p.extend(n..n + m);
+                Ordering::Custom(p)
+            }
+            _ => Ordering::Amd,
+        };
+        let ldlt = SparseLdlt::analyze(&exact, ordering).map_err(core)?;
+        let factor_mat = match self.method {
+            KktMethod::AmdRegularizedLdlt { .. } | KktMethod::Compliant { .. } => Some(exact.clone()),
+            _ => None,
+        };
+        self.kkt = Some(KktCache { n, m, exact, factor_mat, a_map, ldlt });
+        Ok(())
+    }
+
+    fn solve_kkt(&mut self, sys: &ImplicitSystem, r: &[f64]) -> shells::Result<(Vec<f64>, Vec<f64>)> {
+        if self.kkt.as_ref().is_none_or(|k| k.a_map.len() != sys.a.val().len() || k.n != sys.a.nrows()) {
+            self.build_kkt(sys.a)?;
+        }
+        let method = self.method;
+        let refine = self.refine_steps;
+        let kkt = self.kkt.as_mut().expect("built above");
+        let (n, m) = (kkt.n, kkt.m);
+        let av = sys.a.val();
+        let max_diag = (0..n)
+            .map(|j| {
+                let s = sys.a.symbolic();
+                s.col_range(j).find(|&k| s.row_idx()[k] == j).map_or(0.0, |k| av[k].abs())
+            })
+            .fold(0.0f64, f64::max);
+        {
+            let ev = kkt.exact.val_mut();
+            for (k, &p) in kkt.a_map.iter().enumerate() {
+                ev[p] = av[k];
+            }
+        }
+        let shift = match method {
+            KktMethod::AmdRegularizedLdlt { delta } => delta * max_diag,
+            KktMethod::Compliant { compliance } => compliance,
+            _ => 0.0,
+        };
+        if let Some(fm) = kkt.factor_mat.as_mut() {
+            fm.val_mut().copy_from_slice(kkt.exact.val());
+            let s = fm.symbolic();
+            let diag: Vec<usize> = (n..n + m).map(|j| s.col_range(j).start).collect();
+            let fv = fm.val_mut();
+            for p in diag {
+                fv[p] = -shift;
+            }
+        }
+        let mut reg = Regularization::kkt(n, m);
+        reg.eps = 1e-13 * max_diag;
+        reg.delta = 1e-8 * max_diag.max(1e-300);
+        let fmat = kkt.factor_mat.as_ref().unwrap_or(&kkt.exact);
+        kkt.ldlt.factor(fmat, &reg).map_err(core)?;
+        let mut rhs = sys.b.to_vec();
+        rhs.extend_from_slice(r);
+        let mut x = vec![0.0; n + m];
+        let res = match method {
+            KktMethod::Compliant { .. } => kkt.ldlt.solve_refined(fmat, &rhs, &mut x, 0),
+            KktMethod::AmdRegularizedLdlt { .. } => kkt.ldlt.solve_refined(&kkt.exact, &rhs, &mut x, refine.max(2)),
+            _ => kkt.ldlt.solve_refined(&kkt.exact, &rhs, &mut x, refine),
+        }
+        .map_err(core)?;
+        self.last.refinement_residual = res;
+        self.last.nnz_l = kkt.ldlt.nnz_l();
+        let mu = x.split_off(n);
+        Ok((x, mu))
+    }
+
+    fn solve_schur(&mut self, sys: &ImplicitSystem, r: &[f64]) -> shells::Result<(Vec<f64>, Vec<f64>)> {
+        let n = sys.a.nrows();
+        let m = 3 * self.cons.len();
+        let llt = self.llt.get_or_insert_with(|| SparseLlt::from_symbolic(&self.a_symbolic));
+        llt.factor(sys.a).map_err(core)?;
+        // Y = A⁻¹ Ĉᵀ (n × 3K).
+        let cft = self.cft.as_ref().expect("built before use");
+        let mut y = Mat::<f64>::zeros(n, m);
+        for (f, row) in cft.iter().enumerate() {
+            for &(i, w) in row {
+                for d in 0..3 {
+                    y[(3 * f + d, 3 * i as usize + d)] = w;
+                }
+            }
+        }
+        llt.solve_many_in_place(&mut y).map_err(core)?;
+        let mut x0 = sys.b.to_vec();
+        llt.solve_in_place(&mut x0).map_err(core)?;
+        self.last.nnz_l = llt.nnz_l();
+        // S = Ĉ Y (3K × 3K, SPD when Ĉ has full row rank).
+        let mut s = Mat::<f64>::zeros(m, m);
+        for (f, row) in cft.iter().enumerate() {
+            for &(i, w) in row {
+                for d in 0..3 {
+                    let ri = 3 * i as usize + d;
+                    for c in 0..m {
+                        s[(ri, c)] += w * y[(3 * f + d, c)];
+                    }
+                }
+            }
+        }
+        let sf = dense::llt(&s).map_err(core)?;
+        self.lagged_s = Some(sf.clone());
+        let sf = self.lagged_s.as_ref().expect("just set");
+        let mut cx = vec![0.0; m];
+        self.c_mul(&x0, &mut cx);
+        let mut mu: Vec<f64> = cx.iter().zip(r).map(|(a, b)| a - b).collect();
+        sf.solve_in_place(&mut mu).map_err(core)?;
+        let mut dv = x0;
+        for (jj, d) in dv.iter_mut().enumerate() {
+            let mut acc = 0.0;
+            for (c, &mc) in mu.iter().enumerate() {
+                acc += y[(jj, c)] * mc;
+            }
+            *d -= acc;
+        }
+        self.last.refinement_residual = geom_core::linalg::rel_residual(sys.a, &dv, &{
+            let mut ctm = vec![0.0; n];
+            self.ct_mul(&mu, &mut ctm);
+            sys.b.iter().zip(&ctm).map(|(b, c)| b - c).collect::<Vec<_>>()
+        });
+        Ok((dv, mu))
+    }
+
+    fn solve_schur_pcg(
+        &mut self,
+        sys: &ImplicitSystem,
+        r: &[f64],
+        refresh: u32,
+    ) -> shells::Result<(Vec<f64>, Vec<f64>)> {
+        let n = sys.a.nrows();
+        let m = 3 * self.cons.len();
+        if self.refresh_s || self.lagged_s.is_none() {
+            // Exact S at this step (3K solves) and its dense Cholesky; then the solve is direct.
+            let (dv, mu) = self.solve_schur(sys, r)?;
+            self.refresh_s = false;
+            return Ok((dv, mu));
+        }
+        let llt = self.llt.get_or_insert_with(|| SparseLlt::from_symbolic(&self.a_symbolic));
+        llt.factor(sys.a).map_err(core)?;
+        self.last.nnz_l = llt.nnz_l();
+        let mut x0 = sys.b.to_vec();
+        llt.solve_in_place(&mut x0).map_err(core)?;
+        let mut rhs = vec![0.0; m];
+        self.c_mul(&x0, &mut rhs);
+        rhs.iter_mut().zip(r).for_each(|(a, b)| *a -= b);
+        let prec = self.lagged_s.as_ref().expect("checked above");
+        let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+        let bnorm = dot(&rhs, &rhs).sqrt();
+        let mut mu = vec![0.0; m];
+        let mut ay = vec![0.0; n]; // A⁻¹Ĉᵀμ accumulated
+        let mut res = rhs.clone();
+        let mut z = res.clone();
+        prec.solve_in_place(&mut z).map_err(core)?;
+        let mut p = z.clone();
+        let mut rz = dot(&res, &z);
+        let mut it = 0u32;
+        let llt = self.llt.as_ref().expect("factored above");
+        while dot(&res, &res).sqrt() > 1e-10 * bnorm.max(1e-300) && it < 50 {
+            it += 1;
+            let mut w = vec![0.0; n];
+            self.ct_mul(&p, &mut w);
+            llt.solve_in_place(&mut w).map_err(core)?;
+            let mut sp = vec![0.0; m];
+            self.c_mul(&w, &mut sp);
+            let alpha = rz / dot(&p, &sp);
+            for i in 0..m {
+                mu[i] += alpha * p[i];
+                res[i] -= alpha * sp[i];
+            }
+            ay.iter_mut().zip(&w).for_each(|(a, b)| *a += alpha * b);
+            z.copy_from_slice(&res);
+            prec.solve_in_place(&mut z).map_err(core)?;
+            let rz_new = dot(&res, &z);
+            let beta = rz_new / rz;
+            rz = rz_new;
+            for i in 0..m {
+                p[i] = z[i] + beta * p[i];
+            }
+        }
+        if it > refresh {
+            self.refresh_s = true;
+        }
+        let dv: Vec<f64> = x0.iter().zip(&ay).map(|(a, b)| a - b).collect();
+        self.last.refinement_residual = dot(&res, &res).sqrt() / bnorm.max(1e-300);
+        Ok((dv, mu))
+    }
+
+    fn solve_penalty(&mut self, sys: &ImplicitSystem, r: &[f64], kp: f64) -> shells::Result<(Vec<f64>, Vec<f64>)> {
+        let n = sys.a.nrows();
+        let cft = self.cft.as_ref().expect("built before use");
+        let sa = sys.a.symbolic();
+        let av = sys.a.val();
+        let mut t = Triplets::new(n, n);
+        for j in 0..n {
+            for k in sa.col_range(j) {
+                t.push(sa.row_idx()[k] as u32, j as u32, av[k]);
+            }
+        }
+        // k_p ĈᵀĈ, lower triangle: entries (3f+d, 3g+d) for f, g in a common constraint.
+        let k = self.cons.len();
+        let mut rows: Vec<Vec<(u32, f64)>> = vec![Vec::new(); k];
+        for (f, row) in cft.iter().enumerate() {
+            for &(i, w) in row {
+                rows[i as usize].push((f as u32, w));
+            }
+        }
+        for row in &rows {
+            for &(f, wf) in row {
+                for &(g, wg) in row {
+                    if f >= g {
+                        for d in 0..3 {
+                            t.push(3 * f + d, 3 * g + d, kp * wf * wg);
+                        }
+                    }
+                }
+            }
+        }
+        let mat = Csr::from_triplets(&t).to_csc();
+        let sym = match &self.penalty_symbolic {
+            Some(s) => s.clone(),
+            None => {
+                let s = LltSymbolic::analyze(&mat, &Ordering::Amd).map_err(core)?;
+                self.penalty_symbolic = Some(s.clone());
+                s
+            }
+        };
+        let mut llt = SparseLlt::from_symbolic(&sym);
+        llt.factor(&mat).map_err(|_| shells::Error::FactorizationFailed)?;
+        let mut ctr = vec![0.0; n];
+        self.ct_mul(r, &mut ctr);
+        let mut x: Vec<f64> = sys.b.iter().zip(&ctr).map(|(b, c)| b + kp * c).collect();
+        llt.solve_in_place(&mut x).map_err(core)?;
+        self.last.nnz_l = llt.nnz_l();
+        // Equivalent multiplier μ = k_p (r − ĈΔv) (the penalty force).
+        let mut cx = vec![0.0; r.len()];
+        self.c_mul(&x, &mut cx);
+        let mu: Vec<f64> = r.iter().zip(&cx).map(|(a, b)| kp * (b - a)).collect();
+        self.last.refinement_residual = 0.0;
+        Ok((x, mu))
+    }
+}
+
+impl VelocitySolve for TrackingSolver {
+    fn solve(&mut self, sys: &ImplicitSystem) -> shells::Result<Vec<f64>> {
+        let t0 = Instant::now();
+        self.build_cft(sys);
+        self.last.guide_held = self.guide.sample(sys.t_next, &mut self.gbuf);
+        let k = self.cons.len();
+        let mut g = vec![Vec3::zeros(); k];
+        self.cons.residual(&self.gbuf, sys.q_pred, &mut g);
+        let c = self.correction_fraction / sys.h_eff;
+        let r: Vec<f64> = g.iter().flat_map(|gi| [c * gi.x, c * gi.y, c * gi.z]).collect();
+        let (dv, mu) = match self.method {
+            KktMethod::Schur => self.solve_schur(sys, &r)?,
+            KktMethod::SchurPcg { refresh_iters } => self.solve_schur_pcg(sys, &r, refresh_iters)?,
+            KktMethod::Penalty { stiffness } => self.solve_penalty(sys, &r, stiffness)?,
+            _ => self.solve_kkt(sys, &r)?,
+        };
+        self.last.t_kkt = t0.elapsed().as_secs_f64();
+        // Residual before collisions: g(q⁰ + h_eff Δv) on every vertex (constrained ones at q⁰).
+        let mut q_end = sys.q_pred.to_vec();
+        for (f, &v) in sys.dofs.free_vertices.iter().enumerate() {
+            q_end[v as usize] += sys.h_eff * Vec3::new(dv[3 * f], dv[3 * f + 1], dv[3 * f + 2]);
+        }
+        self.last.residual_pre = self.cons.max_residual(&self.gbuf, &q_end);
+        let mut fc = vec![0.0; dv.len()];
+        self.ct_mul(&mu, &mut fc);
+        self.last.max_constraint_force =
+            fc.chunks(3).map(|c| (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()).fold(0.0, f64::max) / sys.h;
+        if self.shadow {
+            let ts = Instant::now();
+            let llt = self.shadow_llt.get_or_insert_with(|| SparseLlt::from_symbolic(&self.a_symbolic));
+            llt.factor(sys.a).map_err(core)?;
+            self.last.t_shadow_llt = ts.elapsed().as_secs_f64();
+        }
+        Ok(dv)
+    }
+}

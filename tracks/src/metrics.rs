@@ -1,0 +1,242 @@
+//! Metrics of spec §3.8 (computed outside the timed step): low-pass filter, coarse-scale
+//! deviation D_c, detail amplitude a_d, detail wavelength λ_eff, bending energy and tug index
+//! (Fig. 3/4), non-rigidity and seam–joint alignment (Fig. 7).
+
+use geom_core::linalg::{Csr, Ordering, SparseLlt};
+use geom_core::math::{Mat3, Pt3, Vec3};
+use geom_core::mesh::TriMesh;
+use shells::ShellSim;
+
+use crate::error::Result;
+use crate::guide::GuideAnimation;
+
+/// The low-pass filter L_τ = (M_L + τK)⁻¹ M_L on a rest mesh (M_L lumped areas, K the PSD
+/// cotangent Laplacian), factorised once.
+pub struct LowPass {
+    /// Lumped (barycentric) vertex areas a_i (m²).
+    pub areas: Vec<f64>,
+    /// Cotangent stiffness K.
+    pub k: Csr,
+    /// τ (m²).
+    pub tau: f64,
+    llt: SparseLlt,
+}
+
+impl LowPass {
+    /// Builds L_τ with τ = (ℓ_c/π)², ℓ_c = sqrt(A_total/K) for `k_regions` test functions (spec
+    /// §3.8), or the given τ.
+    pub fn new(rest: &TriMesh, tau: f64) -> Result<Self> {
+        let areas = geom_core::mesh::mass_barycentric(&rest.faces, &rest.positions);
+        let k = geom_core::mesh::cotan_stiffness(&rest.faces, &rest.positions, Some(1e3));
+        let a = Csr::diag(&areas).add(&k, 1.0, tau);
+        let csc = a.to_csc_lower();
+        let mut llt = SparseLlt::analyze(&csc, Ordering::Amd)?;
+        llt.factor(&csc)?;
+        Ok(Self { areas, k, tau, llt })
+    }
+
+    /// τ = (ℓ_c/π)² with ℓ_c = sqrt(A_total / K).
+    pub fn tau_for(rest: &TriMesh, k_regions: usize) -> f64 {
+        let a: f64 = geom_core::mesh::face_areas(&rest.faces, &rest.positions).iter().sum();
+        let lc = (a / k_regions.max(1) as f64).sqrt();
+        (lc / std::f64::consts::PI).powi(2)
+    }
+
+    /// L_τ d.
+    pub fn apply(&self, d: &[Vec3]) -> Result<Vec<Vec3>> {
+        let mut out = vec![Vec3::zeros(); d.len()];
+        for c in 0..3 {
+            let mut x: Vec<f64> = d.iter().zip(&self.areas).map(|(v, a)| a * v[c]).collect();
+            self.llt.solve_in_place(&mut x)?;
+            out.iter_mut().zip(&x).for_each(|(o, v)| o[c] = *v);
+        }
+        Ok(out)
+    }
+
+    /// Area-weighted RMS norm sqrt(Σ a_i‖x_i‖² / Σ a_i).
+    pub fn rms(&self, x: &[Vec3]) -> f64 {
+        let tot: f64 = self.areas.iter().sum();
+        (x.iter().zip(&self.areas).map(|(v, a)| a * v.norm_squared()).sum::<f64>() / tot).sqrt()
+    }
+
+    /// Coarse-scale deviation D_c = rms(L_τ d) / L (dimensionless), d = q − q̄_f.
+    pub fn coarse_deviation(&self, d: &[Vec3], scale: f64) -> Result<f64> {
+        Ok(self.rms(&self.apply(d)?) / scale)
+    }
+
+    /// Detail amplitude a_d = rms(d − L_τ d) (m).
+    pub fn detail_amplitude(&self, d: &[Vec3]) -> Result<f64> {
+        let lo = self.apply(d)?;
+        let h: Vec<Vec3> = d.iter().zip(&lo).map(|(a, b)| a - b).collect();
+        Ok(self.rms(&h))
+    }
+
+    /// Detail wavelength λ_eff = 2π sqrt(hᵀM_L h / hᵀK h) (m) of a field h (for a sinusoid of
+    /// wavelength λ on a flat mesh this returns λ). Infinite for h in the kernel of K.
+    pub fn wavelength(&self, h: &[Vec3]) -> f64 {
+        let mut num = 0.0;
+        let mut den = 0.0;
+        for c in 0..3 {
+            let x: Vec<f64> = h.iter().map(|v| v[c]).collect();
+            let mut kx = vec![0.0; x.len()];
+            self.k.mul_vec(&x, &mut kx);
+            num += x.iter().zip(&self.areas).map(|(v, a)| a * v * v).sum::<f64>();
+            den += x.iter().zip(&kx).map(|(a, b)| a * b).sum::<f64>();
+        }
+        if den <= 0.0 {
+            f64::INFINITY
+        } else {
+            std::f64::consts::TAU * (num / den).sqrt()
+        }
+    }
+}
+
+/// d = q − q̄_f with q̄_f = P q̄ (or q̄ itself for identical meshes).
+pub fn guide_on_tracked(prolongation: Option<&Csr>, guide_q: &[Pt3]) -> Vec<Pt3> {
+    match prolongation {
+        None => guide_q.to_vec(),
+        Some(p) => {
+            let mut out = vec![Pt3::origin(); p.nrows];
+            for c in 0..3 {
+                let x: Vec<f64> = guide_q.iter().map(|v| v[c]).collect();
+                let mut y = vec![0.0; p.nrows];
+                p.mul_vec(&x, &mut y);
+                out.iter_mut().zip(&y).for_each(|(o, v)| o[c] = *v);
+            }
+            out
+        }
+    }
+}
+
+/// Per-hinge bending energy k ω Δθ² of configuration q (J), shells' hinge model.
+pub fn hinge_energies(sim: &ShellSim, q: &[Pt3]) -> Vec<f64> {
+    sim.mesh().hinges.iter().map(|h| shells::kernels::bending::bending_energy(h, &h.v.map(|i| q[i as usize]))).collect()
+}
+
+/// Tug index (Fig. 3/4): share of the bending energy on hinges whose edge lies in the closed
+/// one-ring of an anchor vertex, divided by the share of rest area of the anchors' incident
+/// triangles. ≈ 1 for smooth tracking, ≫ 1 when anchors tug. 1 when the energy is zero.
+pub fn tug_index(sim: &ShellSim, q: &[Pt3], anchors: &[u32]) -> f64 {
+    let mesh = sim.mesh();
+    let n = mesh.n_vertices();
+    let mut near = vec![false; n];
+    let mut anchor = vec![false; n];
+    anchors.iter().for_each(|&a| anchor[a as usize] = true);
+    let mut area_near = 0.0;
+    let mut area_tot = 0.0;
+    for t in &mesh.tris {
+        let x = t.map(|v| mesh.rest[v as usize]);
+        let a = 0.5 * (x[1] - x[0]).cross(&(x[2] - x[0])).norm();
+        area_tot += a;
+        if t.iter().any(|&v| anchor[v as usize]) {
+            area_near += a;
+            t.iter().for_each(|&v| near[v as usize] = true);
+        }
+    }
+    let e = hinge_energies(sim, q);
+    let tot: f64 = e.iter().sum();
+    if tot <= 0.0 || area_near <= 0.0 {
+        return 1.0;
+    }
+    let en: f64 = mesh
+        .hinges
+        .iter()
+        .zip(&e)
+        .filter(|(h, _)| near[h.v[0] as usize] && near[h.v[1] as usize])
+        .map(|(_, e)| e)
+        .sum();
+    (en / tot) / (area_near / area_tot)
+}
+
+/// RMS residual of the best rigid fit (Kabsch) of `rest` onto `cur` (same length).
+pub fn rigid_fit_rms(rest: &[Pt3], cur: &[Pt3]) -> f64 {
+    let n = rest.len() as f64;
+    if rest.is_empty() {
+        return 0.0;
+    }
+    let ca = rest.iter().fold(Vec3::zeros(), |s, p| s + p.coords) / n;
+    let cb = cur.iter().fold(Vec3::zeros(), |s, p| s + p.coords) / n;
+    let mut h = Mat3::zeros();
+    for (a, b) in rest.iter().zip(cur) {
+        h += (a.coords - ca) * (b.coords - cb).transpose();
+    }
+    let svd = h.svd(true, true);
+    let (u, vt) = (svd.u.expect("requested"), svd.v_t.expect("requested"));
+    let mut d = Mat3::identity();
+    if (vt.transpose() * u.transpose()).determinant() < 0.0 {
+        d[(2, 2)] = -1.0;
+    }
+    let r = vt.transpose() * d * u.transpose();
+    (rest.iter().zip(cur).map(|(a, b)| (r * (a.coords - ca) - (b.coords - cb)).norm_squared()).sum::<f64>() / n).sqrt()
+}
+
+/// Non-rigidity (Fig. 7): for each region, the max over `times` of the rigid-fit RMS residual of
+/// its guide vertices (frame vs rest) divided by the region's rest diameter (bounding-box
+/// diagonal); averaged over regions.
+pub fn non_rigidity(guide: &GuideAnimation, vertex_labels: &[u32], k: usize, times: &[f64]) -> f64 {
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); k];
+    for (v, &l) in vertex_labels.iter().enumerate() {
+        if l != geom_core::NONE {
+            members[l as usize].push(v);
+        }
+    }
+    let rest = &guide.rest.positions;
+    let mut worst = vec![0.0f64; k];
+    let mut buf = vec![Pt3::origin(); rest.len()];
+    for &t in times {
+        guide.sample(t, &mut buf);
+        for (r, m) in members.iter().enumerate() {
+            let a: Vec<Pt3> = m.iter().map(|&v| rest[v]).collect();
+            let b: Vec<Pt3> = m.iter().map(|&v| buf[v]).collect();
+            let diam = geom_core::mesh::bbox_of(&a).map_or(0.0, |(lo, hi)| (hi - lo).norm());
+            if diam > 0.0 {
+                worst[r] = worst[r].max(rigid_fit_rms(&a, &b) / diam);
+            }
+        }
+    }
+    let used = members.iter().filter(|m| !m.is_empty()).count().max(1);
+    worst.iter().sum::<f64>() / used as f64
+}
+
+/// Seam–joint alignment (Fig. 7): fraction of seam edges (endpoints in different regions) whose
+/// endpoints both have max skinning weight < 0.8, divided by the same fraction over all edges.
+pub fn seam_joint_alignment(mesh: &TriMesh, vertex_labels: &[u32], max_weight: &[f64]) -> f64 {
+    let edges = mesh.topology().edges();
+    let joint = |e: &[u32; 2]| max_weight[e[0] as usize] < 0.8 && max_weight[e[1] as usize] < 0.8;
+    let all = edges.iter().filter(|e| joint(e)).count() as f64 / edges.len().max(1) as f64;
+    let seams: Vec<&[u32; 2]> =
+        edges.iter().filter(|e| vertex_labels[e[0] as usize] != vertex_labels[e[1] as usize]).collect();
+    if seams.is_empty() || all == 0.0 {
+        return 0.0;
+    }
+    let s = seams.iter().filter(|e| joint(e)).count() as f64 / seams.len() as f64;
+    s / all
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geom_core::procedural::{grid, GridSpec};
+
+    /// λ_eff of a sinusoid of wavelength λ on a fine flat grid returns λ (2 % for the
+    /// discretisation at 20 samples per wavelength).
+    #[test]
+    fn wavelength_of_sinusoid() {
+        let m = grid(&GridSpec { quads: [80, 8], size: [2.0, 0.2], ..GridSpec::default() }).expect("grid");
+        let lp = LowPass::new(&m, 0.0).expect("lowpass");
+        let lambda = 0.5;
+        let h: Vec<Vec3> =
+            m.positions.iter().map(|p| Vec3::new(0.0, 0.0, (std::f64::consts::TAU * p.x / lambda).sin())).collect();
+        let w = lp.wavelength(&h);
+        assert!((w - lambda).abs() < 0.02 * lambda, "λ_eff = {w}");
+    }
+
+    /// Kabsch: a rigid motion has zero residual (1e-12).
+    #[test]
+    fn rigid_fit_zero_for_rigid_motion() {
+        let a: Vec<Pt3> = (0..10).map(|i| Pt3::new(i as f64, (i * i) as f64 * 0.1, (i as f64).sin())).collect();
+        let r = geom_core::math::UnitQuat::from_scaled_axis(Vec3::new(0.3, -1.0, 0.4));
+        let b: Vec<Pt3> = a.iter().map(|p| Pt3::from(r * p.coords + Vec3::new(1.0, 2.0, 3.0))).collect();
+        assert!(rigid_fit_rms(&a, &b) < 1e-12);
+    }
+}
