@@ -16,6 +16,7 @@ pub mod error;
 pub mod graph;
 pub mod image;
 pub mod io;
+pub mod iso;
 pub mod linalg;
 pub mod math;
 pub mod mesh;

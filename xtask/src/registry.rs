@@ -58,6 +58,7 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::shells::register(&mut v);
     crate::scenes::tracks::register(&mut v);
     crate::scenes::curve_skin::register(&mut v);
+    crate::scenes::rigging::register(&mut v);
     v
 }
 
@@ -78,6 +79,11 @@ pub fn benches() -> Vec<Bench> {
             crate_name: "curve-skin",
             description: "curve skinning: frame-table size, LBS influence count and method cost against accuracy",
             run: crate::bench_curve_skin::run,
+        },
+        Bench {
+            crate_name: "rigging",
+            description: "automatic rigging: tau, packing cap and refinement iterations vs embedding success, joint error and time",
+            run: crate::bench_rigging::run,
         },
         Bench {
             crate_name: "shells",

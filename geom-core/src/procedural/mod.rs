@@ -6,6 +6,7 @@
 //! [`crate::Error::InvalidParameter`] naming the bad one.
 
 mod boxes;
+pub mod character;
 mod grid;
 mod icosphere;
 mod tube;

@@ -3,5 +3,6 @@
 pub mod barnet;
 pub mod curve_skin;
 pub mod geom_core;
+pub mod rigging;
 pub mod shells;
 pub mod tracks;
