@@ -1,1 +1,32 @@
-//! Motion graphs: synthesis by randomized search over a hierarchy of motion graphs (Arikan and Forsyth 2002).
+//! Motion graphs: synthesis by randomized search over a hierarchy of motion graphs
+//! (Okan Arikan and D. A. Forsyth, "Interactive Motion Generation from Examples", SIGGRAPH 2002;
+//! spec `motion-graph.md`).
+//!
+//! Pipeline: [`Database`] (resample to one rate, fragment, contacts and labels) →
+//! [`MotionGraph::build`] (torso-frame features, frame-to-frame cost §3.2, edges below a
+//! threshold τ §3.3, hierarchy of graphs by edge clustering §3.4) → [`Search`] (randomized search
+//! over paths §3.5–3.8 for a [`Problem`] of soft and hard constraints) → [`assemble`], [`smooth`]
+//! (±W frames around each cut, §3.10) and [`enforce_body`] (exact body constraints, §3.11) →
+//! [`evaluate`] (§3.12 metrics).
+//!
+//! Conventions: metres, seconds, radians inside (degrees in scene files); +Y up, characters
+//! face +Z; frames at the database rate (default 30 Hz).
+
+pub mod assemble;
+pub mod db;
+pub mod error;
+pub mod features;
+pub mod graph;
+pub mod kmeans;
+pub mod path;
+pub mod problem;
+pub mod search;
+
+pub use assemble::{assemble, enforce_body, evaluate, kernel, smooth, Assembled, ClipStats, Metrics};
+pub use db::{Database, DbParams};
+pub use error::{Error, Result};
+pub use features::{FeatureTable, JointWeights};
+pub use graph::{EdgeId, EdgeNode, FrameRef, GraphParams, GraphStats, MotionGraph};
+pub use path::{Path, ScoreParts, Scored};
+pub use problem::{BodyConstraint, Disc, HardConstraint, JointConstraint, Problem, StyleConstraint, Weights};
+pub use search::{Search, SearchParams, StepReport, Tolerance};

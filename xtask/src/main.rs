@@ -5,6 +5,7 @@
 mod bench_barnet;
 mod bench_curve_skin;
 mod bench_geom_core;
+mod bench_motion_graph;
 mod bench_rigging;
 mod bench_shells;
 mod bench_tracks;

@@ -59,6 +59,7 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::tracks::register(&mut v);
     crate::scenes::curve_skin::register(&mut v);
     crate::scenes::rigging::register(&mut v);
+    crate::scenes::motion_graph::register(&mut v);
     v
 }
 
@@ -94,6 +95,11 @@ pub fn benches() -> Vec<Bench> {
             crate_name: "tracks",
             description: "tracks: 16 … 1024 clustered regions on the Xavier clip, deviation and wavelength vs time per frame",
             run: crate::bench_tracks::run,
+        },
+        Bench {
+            crate_name: "motion-graph",
+            description: "motion graphs: search budget vs constraint error (hierarchy on/off), graph density, database size, smoothing window",
+            run: crate::bench_motion_graph::run,
         },
     ]
 }

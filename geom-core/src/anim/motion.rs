@@ -80,6 +80,25 @@ impl FrameLabels {
     }
 }
 
+/// Thresholds of [`Motion::detect_contacts`] (motion-graph.md §3.1 step 3, §4).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContactParams {
+    /// Height above the point's floor level below which it may be in contact (m); default 0.03.
+    pub height: f64,
+    /// Horizontal speed below which it may be in contact (m/s); default 0.4.
+    pub speed: f64,
+    /// Percentile of the point's height over the clip taken as its floor level; default 5.
+    pub floor_percentile: f64,
+    /// Gaps of at most this many frames between contact frames are filled; default 2.
+    pub fill_gap: usize,
+}
+
+impl Default for ContactParams {
+    fn default() -> Self {
+        Self { height: 0.03, speed: 0.4, floor_percentile: 5.0, fill_gap: 2 }
+    }
+}
+
 /// A motion clip on one skeleton: `len()` frames sampled every `frame_time` seconds.
 ///
 /// `rot` holds the local joint rotations, frames × joints row-major (`rot[f·J + j]`);
@@ -359,6 +378,69 @@ impl Motion {
             (0..n_out).map(|k| if k + 1 == n_out { (n - 1) as f64 } else { k as f64 * r }).collect()
         };
         self.resampled(&us, self.frame_time)
+    }
+
+    /// Sets the contact flags of every frame from the foot points' motion (motion-graph.md §3.1
+    /// step 3): a foot point (ankle, toe) is in contact when its height is below
+    /// `h_floor + p.height` and its horizontal speed (central differences, one-sided at the ends)
+    /// below `p.speed`, where `h_floor` is the clip's `p.floor_percentile`-th percentile height of
+    /// that point; runs of at most `p.fill_gap` non-contact frames between contacts are filled.
+    /// Points whose role is missing get no flags. Replaces any previous flags.
+    pub fn detect_contacts(&mut self, p: &ContactParams) {
+        let n = self.len();
+        self.labels.contacts = vec![0; n];
+        if n == 0 {
+            return;
+        }
+        let s = self.skeleton.clone();
+        let pts = [
+            (FrameLabels::L_ANKLE, s.role(JointRole::LeftAnkle)),
+            (FrameLabels::L_TOE, s.role(JointRole::LeftToe)),
+            (FrameLabels::R_ANKLE, s.role(JointRole::RightAnkle)),
+            (FrameLabels::R_TOE, s.role(JointRole::RightToe)),
+        ];
+        let nj = self.n_joints();
+        let mut all = vec![Pt3::origin(); n * nj];
+        for f in 0..n {
+            self.joint_positions(f, &mut all[f * nj..(f + 1) * nj]);
+        }
+        for (bit, j) in pts {
+            let Some(j) = j else { continue };
+            let j = j as usize;
+            let y: Vec<f64> = (0..n).map(|f| all[f * nj + j].y).collect();
+            let mut sorted = y.clone();
+            sorted.sort_by(f64::total_cmp);
+            let q = (p.floor_percentile.clamp(0.0, 100.0) / 100.0 * (n - 1) as f64).round() as usize;
+            let floor = sorted[q.min(n - 1)];
+            let mut on: Vec<bool> = (0..n)
+                .map(|f| {
+                    let (a, b) = (f.saturating_sub(1), (f + 1).min(n - 1));
+                    let d = all[b * nj + j] - all[a * nj + j];
+                    let speed = if b > a { d.x.hypot(d.z) / ((b - a) as f64 * self.frame_time) } else { 0.0 };
+                    y[f] < floor + p.height && speed < p.speed
+                })
+                .collect();
+            // Fill short gaps between contact runs.
+            let mut f = 0;
+            while f < n {
+                if !on[f] {
+                    let start = f;
+                    while f < n && !on[f] {
+                        f += 1;
+                    }
+                    if start > 0 && f < n && f - start <= p.fill_gap {
+                        on[start..f].iter_mut().for_each(|x| *x = true);
+                    }
+                } else {
+                    f += 1;
+                }
+            }
+            for (c, o) in self.labels.contacts.iter_mut().zip(on) {
+                if o {
+                    *c |= bit;
+                }
+            }
+        }
     }
 
     /// Makes every joint's quaternion sequence continuous in sign: `q_f·q_{f−1} ≥ 0` for every

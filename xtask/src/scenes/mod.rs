@@ -3,6 +3,7 @@
 pub mod barnet;
 pub mod curve_skin;
 pub mod geom_core;
+pub mod motion_graph;
 pub mod rigging;
 pub mod shells;
 pub mod tracks;

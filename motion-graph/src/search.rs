@@ -1,0 +1,662 @@
+//! Randomized search (motion-graph.md §3.7, §3.8): seed paths on the coarsest graph G⁰ that land
+//! exactly on hard constraints, mutations (replace a range of edges by 0, 1 or 2 top edges;
+//! demote two adjacent edges to their children; trim the ends), and the population loop that
+//! keeps improving children, records local minima and adds fresh seeds every iteration.
+
+use crate::graph::{EdgeId, FrameRef, MotionGraph};
+use crate::path::{hard_ok, place, score, score_value, Compiled, Hard, Path, Scored};
+use crate::problem::Problem;
+use crate::{Error, Result};
+use geom_core::rng::Rng;
+use serde::{Deserialize, Serialize};
+use std::collections::{HashMap, HashSet};
+use std::time::{Duration, Instant};
+
+/// Search parameters (§4).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SearchParams {
+    /// Initial population (default 20).
+    pub seeds: usize,
+    /// Fresh seeds per iteration (default 2).
+    pub new_seeds_per_iter: usize,
+    /// Improving children kept per path (default 2).
+    pub keep_best: usize,
+    /// Population bound (default 64).
+    pub population_cap: usize,
+    /// Longest edge range replaced (default 4).
+    pub max_span: usize,
+    /// Candidates scored per path per iteration (default 4000).
+    pub max_mutations: usize,
+    /// Shortest piece (frames, default 6).
+    pub min_piece_frames: u32,
+    /// The seed walk stops this many frames before a hard constraint to land on it (default 90).
+    pub landing_window: u32,
+    /// Seed-generation retries (default 200).
+    pub max_seed_tries: usize,
+    /// Distinct local minima kept (default 5).
+    pub results: usize,
+    /// Enable the trim mutation (default on).
+    pub trim: bool,
+    /// All randomness.
+    pub rng_seed: u64,
+}
+
+impl Default for SearchParams {
+    fn default() -> Self {
+        Self {
+            seeds: 20,
+            new_seeds_per_iter: 2,
+            keep_best: 2,
+            population_cap: 64,
+            max_span: 4,
+            max_mutations: 4000,
+            min_piece_frames: 6,
+            landing_window: 90,
+            max_seed_tries: 200,
+            results: 5,
+            trim: true,
+            rng_seed: 1,
+        }
+    }
+}
+
+/// "Acceptable" thresholds (§12.13).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Tolerance {
+    /// Body position (m).
+    pub pos_m: f64,
+    /// Heading (deg).
+    pub yaw_deg: f64,
+    /// Length (frames).
+    pub frames: u32,
+    /// Joint position (m).
+    pub joint_m: f64,
+}
+
+impl Default for Tolerance {
+    fn default() -> Self {
+        Self { pos_m: 0.30, yaw_deg: 10.0, frames: 10, joint_m: 0.30 }
+    }
+}
+
+impl Tolerance {
+    /// Whether a scored path meets the tolerance.
+    pub fn met(&self, s: &Scored) -> bool {
+        s.errors.body_pos.iter().all(|&e| e <= self.pos_m)
+            && s.errors.body_yaw_deg.iter().all(|&e| e <= self.yaw_deg)
+            && s.errors.joint.iter().all(|&e| e <= self.joint_m)
+            && s.errors.length <= self.frames
+    }
+}
+
+/// What one iteration did.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct StepReport {
+    /// Iteration number (1-based).
+    pub iteration: usize,
+    /// Candidates scored.
+    pub candidates: usize,
+    /// Population size after the step.
+    pub population: usize,
+    /// Best score so far.
+    pub best: f64,
+}
+
+/// An anytime randomized search (§2.4).
+pub struct Search<'g> {
+    g: &'g MotionGraph,
+    cp: Compiled,
+    p: SearchParams,
+    rng: Rng,
+    population: Vec<Scored>,
+    results: Vec<Scored>,
+    seen_results: HashSet<Vec<EdgeId>>,
+    stalls: HashMap<Path, u8>,
+    best: Option<Scored>,
+    iterations: usize,
+    /// Seeds that failed (for reports).
+    pub seed_failures: usize,
+}
+
+/// Iterations without an improving candidate after which a path counts as a local minimum.
+const STALL_LIMIT: u8 = 3;
+
+/// First edges drawn per replaced range for two-edge (one-hop) fills.
+const TWO_HOP_DRAWS: usize = 6;
+
+/// Up to two replacement edges.
+#[derive(Clone, Copy)]
+struct Fill {
+    e: [EdgeId; 2],
+    n: u8,
+}
+
+impl Fill {
+    fn of(es: &[EdgeId]) -> Fill {
+        let mut e = [0; 2];
+        e[..es.len()].copy_from_slice(es);
+        Fill { e, n: es.len() as u8 }
+    }
+}
+
+/// Reservoir of candidates (algorithm R): a uniform random subset of at most `cap` of all the
+/// candidates offered, without materialising them all.
+struct Reservoir<'r> {
+    cap: usize,
+    seen: usize,
+    items: Vec<Cand>,
+    rng: &'r mut Rng,
+}
+
+impl Reservoir<'_> {
+    fn offer(&mut self, c: Cand) {
+        self.seen += 1;
+        if self.items.len() < self.cap {
+            self.items.push(c);
+        } else {
+            let j = self.rng.below(self.seen);
+            if j < self.cap {
+                self.items[j] = c;
+            }
+        }
+    }
+}
+
+/// A candidate mutation: replace `cuts[i..k]` by `with`, optionally set start/end frames.
+struct Cand {
+    i: usize,
+    k: usize,
+    with: Fill,
+    start: Option<FrameRef>,
+    end: Option<u32>,
+}
+
+impl<'g> Search<'g> {
+    /// Validates the problem and builds the initial population. Errors: those of the problem
+    /// (§8) and [`Error::NoSeedPath`] when no seed meets the hard constraints within
+    /// `max_seed_tries`.
+    pub fn new(g: &'g MotionGraph, pb: Problem, p: SearchParams) -> Result<Search<'g>> {
+        let cp = Compiled::new(g, pb)?;
+        let mut s = Search {
+            g,
+            cp,
+            rng: Rng::new(p.rng_seed),
+            p,
+            population: Vec::new(),
+            results: Vec::new(),
+            seen_results: HashSet::new(),
+            stalls: HashMap::new(),
+            best: None,
+            iterations: 0,
+            seed_failures: 0,
+        };
+        let mut tries = 0;
+        let mut last_reason = String::from("no attempt");
+        while s.population.len() < s.p.seeds.max(1) && tries < s.p.max_seed_tries.max(1) {
+            tries += 1;
+            match s.seed() {
+                Ok(sc) => s.push(sc),
+                Err(r) => {
+                    s.seed_failures += 1;
+                    last_reason = r;
+                }
+            }
+        }
+        if s.population.is_empty() {
+            return Err(Error::NoSeedPath { tries, reason: last_reason });
+        }
+        Ok(s)
+    }
+
+    fn push(&mut self, sc: Scored) {
+        if self.best.as_ref().is_none_or(|b| sc.score < b.score) {
+            self.best = Some(sc.clone());
+        }
+        self.population.push(sc);
+    }
+
+    /// Random choice among candidate edges, probability ∝ exp(−cost).
+    fn pick(&mut self, cands: &[EdgeId]) -> Option<EdgeId> {
+        if cands.is_empty() {
+            return None;
+        }
+        let w: Vec<f64> = cands.iter().map(|&e| (-(self.g.edges[e as usize].cost as f64)).exp()).collect();
+        let total: f64 = w.iter().sum();
+        let mut u = self.rng.f64() * total;
+        for (c, wi) in cands.iter().zip(&w) {
+            if u < *wi {
+                return Some(*c);
+            }
+            u -= wi;
+        }
+        cands.last().copied()
+    }
+
+    /// One random seed path (§3.7); `Err(reason)` on failure.
+    fn seed(&mut self) -> std::result::Result<Scored, String> {
+        let g = self.g;
+        let minp = self.p.min_piece_frames.max(1);
+        let target = self.cp.target;
+        let hard = self.cp.hard.clone();
+        // Start.
+        let start = match hard.first() {
+            Some((0, h)) => {
+                let cands: Vec<FrameRef> = match h {
+                    Hard::Frame(f) => vec![*f],
+                    Hard::Label(_) => (0..g.db.clips.len() as u32)
+                        .flat_map(|c| (0..g.clip_len(c)).map(move |f| FrameRef { clip: c, frame: f }))
+                        .filter(|f| hard_ok(g, h, *f))
+                        .collect(),
+                };
+                if cands.is_empty() {
+                    return Err("no frame meets the time-0 hard constraint".into());
+                }
+                cands[self.rng.below(cands.len())]
+            }
+            _ => {
+                let c = self.rng.below(g.db.clips.len()) as u32;
+                let len = g.clip_len(c);
+                if len < minp {
+                    return Err("start clip shorter than a piece".into());
+                }
+                FrameRef { clip: c, frame: self.rng.below((len - minp + 1) as usize) as u32 }
+            }
+        };
+        let mut next_hard = usize::from(matches!(hard.first(), Some((0, _))));
+        let (mut s, mut a, mut ta) = (start.clip, start.frame, 0u32);
+        let mut min_from = a + minp - 1;
+        let mut cuts = Vec::new();
+        for _ in 0..10_000 {
+            let len = g.clip_len(s);
+            if let Some(&(th, h)) = hard.get(next_hard) {
+                // Staying in this clip reaches t_h at frame a + (t_h − t_a).
+                let fh = a as u64 + (th - ta) as u64;
+                if fh < len as u64 && hard_ok(g, &h, FrameRef { clip: s, frame: fh as u32 }) {
+                    next_hard += 1;
+                    min_from = min_from.max(fh as u32);
+                    continue;
+                }
+                if th - ta <= self.p.landing_window {
+                    // Land exactly: a leaf (s, i) → (c, j) putting a matching frame at t_h.
+                    let mut land = Vec::new();
+                    for &e in &g.out_leaf[s as usize] {
+                        let n = &g.edges[e as usize];
+                        let i = n.from.frame;
+                        if i < min_from {
+                            continue;
+                        }
+                        let tn = ta + (i - a) + 1;
+                        if tn > th {
+                            break;
+                        }
+                        let f = n.to.frame + (th - tn);
+                        if f < g.clip_len(n.to.clip) && hard_ok(g, &h, FrameRef { clip: n.to.clip, frame: f }) {
+                            land.push(e);
+                        }
+                    }
+                    if let Some(e) = self.pick(&land) {
+                        let n = g.edges[e as usize];
+                        ta += n.from.frame - a + 1;
+                        s = n.to.clip;
+                        a = n.to.frame;
+                        cuts.push(e);
+                        let f = a + (th - ta);
+                        min_from = (a + minp - 1).max(f);
+                        next_hard += 1;
+                        continue;
+                    }
+                }
+                // Random step that does not overshoot t_h.
+                let limit = a as u64 + (th - ta) as u64;
+                let outs: Vec<EdgeId> = g.out_top[s as usize]
+                    .iter()
+                    .copied()
+                    .filter(|&e| {
+                        let fr = g.edges[e as usize].from.frame;
+                        fr >= min_from && (fr as u64) < limit
+                    })
+                    .collect();
+                let Some(e) = self.pick(&outs) else {
+                    return Err(format!("dead end before the hard constraint at frame {th}"));
+                };
+                let n = g.edges[e as usize];
+                ta += n.from.frame - a + 1;
+                s = n.to.clip;
+                a = n.to.frame;
+                min_from = a + minp - 1;
+                cuts.push(e);
+                continue;
+            }
+            // No hard constraint pending: end when the length can be met.
+            let remaining = target.saturating_sub(ta);
+            if a + remaining <= len && remaining >= 1 && a + remaining > min_from {
+                let path = Path { start, cuts, end_frame: a + remaining - 1 };
+                return score(g, &self.cp, &path, minp).ok_or_else(|| "seed failed validation".to_string());
+            }
+            let outs: Vec<EdgeId> =
+                g.out_top[s as usize].iter().copied().filter(|&e| g.edges[e as usize].from.frame >= min_from).collect();
+            match self.pick(&outs) {
+                Some(e) if ta < target => {
+                    let n = g.edges[e as usize];
+                    ta += n.from.frame - a + 1;
+                    s = n.to.clip;
+                    a = n.to.frame;
+                    min_from = a + minp - 1;
+                    cuts.push(e);
+                }
+                _ => {
+                    // Cannot continue: end as close to the target as the clip allows.
+                    if min_from > len - 1 {
+                        return Err("clip too short to end".into());
+                    }
+                    let end = (a + remaining.max(1) - 1).clamp(min_from, len - 1);
+                    let path = Path { start, cuts, end_frame: end };
+                    return score(g, &self.cp, &path, minp).ok_or_else(|| "seed failed validation".to_string());
+                }
+            }
+        }
+        Err("seed walk too long".into())
+    }
+
+    /// Entry clip/frame and exit frame around cut range `[i, k)` of a path.
+    fn hole(&self, path: &Path, i: usize, k: usize) -> (u32, u32, u32, u32) {
+        let g = self.g;
+        let (ca, a0) = if i == 0 {
+            (path.start.clip, path.start.frame)
+        } else {
+            let n = &g.edges[path.cuts[i - 1] as usize];
+            (n.to.clip, n.to.frame)
+        };
+        let (cb, b1) = if k < path.cuts.len() {
+            let n = &g.edges[path.cuts[k] as usize];
+            (n.from.clip, n.from.frame)
+        } else {
+            // Last piece's clip.
+            let clip = if k == 0 { path.start.clip } else { g.edges[path.cuts[k - 1] as usize].to.clip };
+            (clip, path.end_frame)
+        };
+        (ca, a0, cb, b1)
+    }
+
+    /// All mutation candidates of a path (§3.8 a–c).
+    fn mutations(&self, path: &Path, rng: &mut Rng) -> Vec<Cand> {
+        let g = self.g;
+        let minp = self.p.min_piece_frames.max(1);
+        let n = path.cuts.len();
+        let mut out = Reservoir { cap: self.p.max_mutations.max(1), seen: 0, items: Vec::new(), rng };
+        // (a) replace cuts[i..k] (k − i ≤ max_span; k = i is an insertion into a piece).
+        for i in 0..=n {
+            for k in i..=(i + self.p.max_span).min(n) {
+                let (ca, a0, cb, b1) = self.hole(path, i, k);
+                // For an insertion the hole is the piece itself: from its entry to its exit.
+                if k > i && ca == cb && a0 < b1 && b1 + 1 - a0 >= minp {
+                    out.offer(Cand { i, k, with: Fill::of(&[]), start: None, end: None });
+                }
+                if let Some(es) = g.pair_top.get(&(ca, cb)) {
+                    for &e in es {
+                        let nd = &g.edges[e as usize];
+                        if nd.from.frame + 1 >= a0 + minp && nd.to.frame + minp <= b1 + 1 {
+                            out.offer(Cand { i, k, with: Fill::of(&[e]), start: None, end: None });
+                        }
+                    }
+                }
+                // Two-edge fills A → u → B: the first edge is drawn (`TWO_HOP_DRAWS` per range)
+                // among the top edges leaving A late enough; every matching second edge is offered.
+                let outs = &g.out_top[ca as usize];
+                let lo = outs.partition_point(|&e| g.edges[e as usize].from.frame + 1 < a0 + minp);
+                let avail = outs.len() - lo;
+                for _ in 0..TWO_HOP_DRAWS.min(avail) {
+                    let e1 = outs[lo + out.rng.below(avail)];
+                    let n1 = &g.edges[e1 as usize];
+                    if let Some(es) = g.pair_top.get(&(n1.to.clip, cb)) {
+                        for &e2 in es {
+                            let n2 = &g.edges[e2 as usize];
+                            if n2.from.frame + 1 >= n1.to.frame + minp && n2.to.frame + minp <= b1 + 1 {
+                                out.offer(Cand { i, k, with: Fill::of(&[e1, e2]), start: None, end: None });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // (b) demote adjacent pairs (and single edges).
+        let kids = |e: EdgeId| -> Vec<EdgeId> {
+            let nd = &g.edges[e as usize];
+            if nd.is_leaf() {
+                vec![e]
+            } else {
+                nd.children.iter().flatten().copied().collect()
+            }
+        };
+        for k in 0..n {
+            let e = path.cuts[k];
+            if !g.edges[e as usize].is_leaf() {
+                for c in kids(e) {
+                    out.offer(Cand { i: k, k: k + 1, with: Fill::of(&[c]), start: None, end: None });
+                }
+            }
+            if k + 1 < n {
+                let e2 = path.cuts[k + 1];
+                if !g.edges[e as usize].is_leaf() || !g.edges[e2 as usize].is_leaf() {
+                    for c1 in kids(e) {
+                        for c2 in kids(e2) {
+                            out.offer(Cand { i: k, k: k + 2, with: Fill::of(&[c1, c2]), start: None, end: None });
+                        }
+                    }
+                }
+            }
+        }
+        // (d) tail (ours): leave the last piece by a top edge into any clip and end there at the
+        // frame that fits F* (sampled, `TWO_HOP_DRAWS` edges), so short paths can grow.
+        if let Some(pieces) = place(g, path, &self.cp.start, minp) {
+            if let Some(last) = pieces.last() {
+                let outs = &g.out_top[last.clip as usize];
+                let lo = outs.partition_point(|&e| g.edges[e as usize].from.frame + 1 < last.first + minp);
+                let avail = outs.len() - lo;
+                for _ in 0..(2 * TWO_HOP_DRAWS).min(avail) {
+                    let e = outs[lo + out.rng.below(avail)];
+                    let nd = &g.edges[e as usize];
+                    let t_next = last.t0 + (nd.from.frame - last.first + 1);
+                    let rem = self.cp.target.saturating_sub(t_next).max(minp);
+                    let len = g.clip_len(nd.to.clip);
+                    if nd.to.frame + minp > len {
+                        continue;
+                    }
+                    let end = (nd.to.frame + rem - 1).clamp(nd.to.frame + minp - 1, len - 1);
+                    out.offer(Cand { i: n, k: n, with: Fill::of(&[e]), start: None, end: Some(end) });
+                }
+            }
+        }
+        // (c) trim: end frame (and start frame without a time-0 hard constraint) to fit F*.
+        if self.p.trim {
+            if let Some(sc) = score(g, &self.cp, path, minp) {
+                let d = self.cp.target as i64 - sc.frames as i64;
+                if d != 0 {
+                    let last_clip = path.cuts.last().map_or(path.start.clip, |&e| g.edges[e as usize].to.clip);
+                    let end = (path.end_frame as i64 + d).clamp(0, g.clip_len(last_clip) as i64 - 1) as u32;
+                    out.offer(Cand { i: n, k: n, with: Fill::of(&[]), start: None, end: Some(end) });
+                    if !matches!(self.cp.hard.first(), Some((0, _))) {
+                        let st = (path.start.frame as i64 - d).max(0) as u32;
+                        out.offer(Cand {
+                            i: 0,
+                            k: 0,
+                            with: Fill::of(&[]),
+                            start: Some(FrameRef { clip: path.start.clip, frame: st }),
+                            end: None,
+                        });
+                    }
+                }
+            }
+        }
+        out.items
+    }
+
+    fn apply(path: &Path, c: &Cand) -> Path {
+        let mut cuts = Vec::with_capacity(path.cuts.len() + 2);
+        cuts.extend_from_slice(&path.cuts[..c.i]);
+        cuts.extend_from_slice(&c.with.e[..c.with.n as usize]);
+        cuts.extend_from_slice(&path.cuts[c.k..]);
+        Path { start: c.start.unwrap_or(path.start), cuts, end_frame: c.end.unwrap_or(path.end_frame) }
+    }
+
+    /// One iteration of the loop of §3.8.
+    pub fn step(&mut self) -> StepReport {
+        self.iterations += 1;
+        let minp = self.p.min_piece_frames.max(1);
+        let pop = std::mem::take(&mut self.population);
+        let mut next = Vec::new();
+        let mut scored = 0;
+        for p in pop {
+            let mut rng = self.rng.clone();
+            let cands = self.mutations(&p.path, &mut rng);
+            self.rng = rng;
+            // Screen by score value; keep the `keep_best` best improving candidates.
+            let mut top: Vec<(f64, Path)> = Vec::new();
+            let keep = self.p.keep_best.max(1);
+            for c in &cands {
+                let np = Self::apply(&p.path, c);
+                scored += 1;
+                if let Some(v) = score_value(self.g, &self.cp, &np, minp) {
+                    if v < p.score - 1e-12
+                        && (top.len() < keep || v < top[top.len() - 1].0)
+                        && !top.iter().any(|t| t.1 == np)
+                    {
+                        top.push((v, np));
+                        top.sort_by(|a, b| a.0.total_cmp(&b.0));
+                        top.truncate(keep);
+                    }
+                }
+            }
+            let mut improving: Vec<Scored> =
+                top.iter().filter_map(|(_, np)| score(self.g, &self.cp, np, minp)).collect();
+            if improving.is_empty() {
+                // The candidate set is a random subset: a path is a local minimum only after
+                // `STALL_LIMIT` consecutive iterations without an improving candidate.
+                let stalls = self.stalls.entry(p.path.clone()).or_insert(0);
+                *stalls += 1;
+                if *stalls < STALL_LIMIT {
+                    next.push(p);
+                    continue;
+                }
+                self.stalls.remove(&p.path);
+                if self.seen_results.insert(p.path.cuts.clone()) {
+                    self.results.push(p);
+                    self.results.sort_by(|a, b| a.score.total_cmp(&b.score));
+                    self.results.truncate(self.p.results.max(1));
+                }
+            } else {
+                improving.sort_by(|a, b| a.score.total_cmp(&b.score));
+                improving.dedup_by(|a, b| a.path == b.path);
+                improving.truncate(self.p.keep_best.max(1));
+                for s in improving {
+                    if self.best.as_ref().is_none_or(|b| s.score < b.score) {
+                        self.best = Some(s.clone());
+                    }
+                    next.push(s);
+                }
+            }
+        }
+        self.population = next;
+        for _ in 0..self.p.new_seeds_per_iter {
+            match self.seed() {
+                Ok(s) => self.push(s),
+                Err(_) => self.seed_failures += 1,
+            }
+        }
+        self.population.sort_by(|a, b| a.score.total_cmp(&b.score));
+        self.population.dedup_by(|a, b| a.path == b.path);
+        self.population.truncate(self.p.population_cap.max(1));
+        let alive: HashSet<&Path> = self.population.iter().map(|s| &s.path).collect();
+        self.stalls.retain(|k, _| alive.contains(k));
+        StepReport {
+            iteration: self.iterations,
+            candidates: scored,
+            population: self.population.len(),
+            best: self.best.as_ref().map_or(f64::INFINITY, |b| b.score),
+        }
+    }
+
+    /// Iterates until `budget` has elapsed (at least one iteration unless the budget is zero).
+    pub fn run_for(&mut self, budget: Duration) -> &[Scored] {
+        let t0 = Instant::now();
+        while t0.elapsed() < budget && !self.population.is_empty() {
+            self.step();
+        }
+        &self.results
+    }
+
+    /// Iterates until the best path meets `tol` or `max` has elapsed or `max_iters` iterations ran.
+    pub fn run_until(&mut self, tol: &Tolerance, max: Duration, max_iters: usize) -> &[Scored] {
+        let t0 = Instant::now();
+        let mut it = 0;
+        while t0.elapsed() < max && it < max_iters {
+            if self.best.as_ref().is_some_and(|b| tol.met(b)) {
+                break;
+            }
+            if self.population.is_empty() {
+                // Everything converged: restart from fresh seeds (anytime search).
+                for _ in 0..self.p.seeds.max(1) {
+                    if let Ok(s) = self.seed() {
+                        self.push(s);
+                    }
+                }
+                if self.population.is_empty() {
+                    break;
+                }
+            }
+            self.step();
+            it += 1;
+        }
+        &self.results
+    }
+
+    /// The best path found so far (always assemblable).
+    pub fn best(&self) -> Option<&Scored> {
+        self.best.as_ref()
+    }
+
+    /// Distinct local minima, best first.
+    pub fn results(&self) -> &[Scored] {
+        &self.results
+    }
+
+    /// The current population.
+    pub fn population(&self) -> &[Scored] {
+        &self.population
+    }
+
+    /// Iterations run.
+    pub fn iterations(&self) -> usize {
+        self.iterations
+    }
+
+    /// Interactive edit: replaces the problem and rescores the population (paths that no longer
+    /// meet the hard constraints are dropped; new seeds refill it).
+    pub fn set_problem(&mut self, pb: Problem) -> Result<()> {
+        self.cp = Compiled::new(self.g, pb)?;
+        let minp = self.p.min_piece_frames.max(1);
+        let pop = std::mem::take(&mut self.population);
+        self.best = None;
+        self.results.clear();
+        self.seen_results.clear();
+        for p in pop {
+            if let Some(s) = score(self.g, &self.cp, &p.path, minp) {
+                self.push(s);
+            }
+        }
+        while self.population.len() < self.p.seeds {
+            match self.seed() {
+                Ok(s) => self.push(s),
+                Err(_) => break,
+            }
+        }
+        Ok(())
+    }
+
+    /// The compiled problem's start placement and min piece (for assembly).
+    pub fn min_piece(&self) -> u32 {
+        self.p.min_piece_frames.max(1)
+    }
+}
