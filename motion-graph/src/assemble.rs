@@ -7,7 +7,7 @@ use crate::problem::{BodyConstraint, HardConstraint, Problem};
 use geom_core::anim::metrics::{
     foot_skate, splice_discontinuity, within_clip_jump_distribution, JumpDistribution, JumpStats, SkateStats,
 };
-use geom_core::anim::{FrameLabels, Motion};
+use geom_core::anim::{FrameLabels, JointRole, Motion};
 use geom_core::math::{axis_quat, quat_exp, quat_log, wrap_angle, Planar, Pt3, Vec3};
 
 /// An assembled motion with its piece table.
@@ -138,11 +138,68 @@ pub fn smooth(a: &mut Assembled, window: u32) {
     }
 }
 
+/// Cancels the foot sliding that cuts and smoothing introduce (ours, beyond the paper; no IK):
+/// whenever foot points carry a contact flag on a frame and the previous one, the root is moved
+/// horizontally by minus their mean horizontal displacement, and the accumulated offset is kept
+/// for the following frames. A stance foot then stays where it was planted (exactly when one
+/// point, or points sliding alike, are held; double support with different slides keeps their
+/// difference); between contacts the body moves as assembled. Only the root translation
+/// changes (local rotations, heights and headings are untouched), so the pose is the same and the
+/// torso path drifts by the removed sliding, which the body-constraint correction of §3.11 then
+/// takes back — [`enforce_body`] puts its ramp into frames with few held contacts.
+/// Returns the total horizontal offset applied at the last frame (m).
+pub fn fix_contacts(a: &mut Assembled) -> f64 {
+    let m = &mut a.motion;
+    let n = m.len();
+    let s = &m.skeleton;
+    let pts: Vec<(u8, usize)> = [
+        (FrameLabels::L_ANKLE, JointRole::LeftAnkle),
+        (FrameLabels::L_TOE, JointRole::LeftToe),
+        (FrameLabels::R_ANKLE, JointRole::RightAnkle),
+        (FrameLabels::R_TOE, JointRole::RightToe),
+    ]
+    .into_iter()
+    .filter_map(|(bit, r)| s.role(r).map(|j| (bit, j as usize)))
+    .collect();
+    if n < 2 || pts.is_empty() {
+        return 0.0;
+    }
+    let nj = m.n_joints();
+    let mut prev = vec![Pt3::origin(); nj];
+    let mut cur = vec![Pt3::origin(); nj];
+    m.joint_positions(0, &mut prev);
+    let flag = |m: &Motion, f: usize| m.labels.contacts.get(f).copied().unwrap_or(0);
+    let mut off = Vec3::zeros();
+    for f in 1..n {
+        m.joint_positions(f, &mut cur);
+        let held = flag(m, f) & flag(m, f - 1);
+        let mut slide = Vec3::zeros();
+        let mut k = 0;
+        for &(bit, j) in &pts {
+            if held & bit != 0 {
+                let d = cur[j] - prev[j];
+                slide += Vec3::new(d.x, 0.0, d.z);
+                k += 1;
+            }
+        }
+        if k > 0 {
+            off -= slide / k as f64;
+        }
+        std::mem::swap(&mut prev, &mut cur);
+        m.root_pos[f] += off;
+    }
+    off.norm()
+}
+
+/// Per held contact point, how much less a frame takes of the §3.11 ramp than a frame without
+/// contacts: frame weight `1/(1 + CONTACT_RAMP_WEIGHT·k)`.
+const CONTACT_RAMP_WEIGHT: f64 = 100.0;
+
 /// Meets body constraints exactly (§3.11): for consecutive constraints `t_p < t_c`, the
 /// trajectory from `t_p` on is rotated about the torso position at `t_p` by `λΔyaw` and moved by
 /// `λΔ`, where `Δyaw` and `Δ` make the torso frame at `t_c` equal to the target and `λ` rises
 /// from 0 at `t_p` to 1 at `t_c`. The paper's ramp is uniform; here `λ` accumulates per-frame
-/// weights `1/(1 + 10k)` (k = foot points in contact on that and the previous frame), which moves
+/// weights `1/(1 + 100k)` (k = foot points in contact on that and the previous frame), which moves
 /// the correction into flight and single-support frames and so reduces foot skate (our choice;
 /// uniform when no contacts are flagged). Processed in time order; the time-0 constraint is met by placement.
 /// Constraints beyond the motion are applied at its last frame. The time-0 constraint (met by
@@ -186,14 +243,14 @@ pub fn enforce_body(a: &mut Assembled, body: &[BodyConstraint]) {
         let rotated = rot.apply_dir(pc);
         let delta = Vec3::new(b.x - (o.x + rotated.x), 0.0, b.z - (o.z + rotated.z));
         // λ(t): cumulative per-frame weights, so the correction goes where few foot points are
-        // in contact (w = 1/(1 + 10 k), k = contact points held from the previous frame); with
+        // in contact (w = 1/(1 + 100 k), k = contact points held from the previous frame); with
         // no contact information this is the uniform ramp of the paper.
         let held = |t: usize| -> u32 {
             let c = m.labels.contacts.get(t).copied().unwrap_or(0);
             let c0 = m.labels.contacts.get(t.wrapping_sub(1)).copied().unwrap_or(0);
             (c & c0).count_ones()
         };
-        let w: Vec<f64> = (tp + 1..=tc).map(|t| 1.0 / (1.0 + 10.0 * held(t) as f64)).collect();
+        let w: Vec<f64> = (tp + 1..=tc).map(|t| 1.0 / (1.0 + CONTACT_RAMP_WEIGHT * held(t) as f64)).collect();
         let total: f64 = w.iter().sum();
         let mut cum = 0.0;
         let mut lams = Vec::with_capacity(tc - tp);

@@ -4,6 +4,7 @@
 //! keeps improving children, records local minima and adds fresh seeds every iteration.
 
 use crate::graph::{EdgeId, FrameRef, MotionGraph};
+use crate::guided::{guided_seeds, GuidedParams};
 use crate::path::{hard_ok, place, score, score_value, Compiled, Hard, Path, Scored};
 use crate::problem::Problem;
 use crate::{Error, Result};
@@ -40,6 +41,8 @@ pub struct SearchParams {
     pub trim: bool,
     /// All randomness.
     pub rng_seed: u64,
+    /// Guided seeds (beam search toward the constraints, ours; `width: 0` disables them).
+    pub guided: GuidedParams,
 }
 
 impl Default for SearchParams {
@@ -57,6 +60,7 @@ impl Default for SearchParams {
             results: 5,
             trim: true,
             rng_seed: 1,
+            guided: GuidedParams::default(),
         }
     }
 }
@@ -102,6 +106,28 @@ pub struct StepReport {
     pub population: usize,
     /// Best score so far.
     pub best: f64,
+}
+
+/// The head of a random seed walk (§3.7): current clip `s` entered at frame `a` at output time
+/// `ta`, the earliest frame it may be left from, and the cuts so far.
+struct Walk {
+    s: u32,
+    a: u32,
+    ta: u32,
+    min_from: u32,
+    cuts: Vec<EdgeId>,
+}
+
+impl Walk {
+    /// Takes edge `e` (leaving the current clip): the entered frame plays right after `from`.
+    fn follow(&mut self, g: &MotionGraph, e: EdgeId, min_piece: u32) {
+        let n = &g.edges[e as usize];
+        self.ta += n.from.frame - self.a + 1;
+        self.s = n.to.clip;
+        self.a = n.to.frame;
+        self.min_from = self.a + min_piece - 1;
+        self.cuts.push(e);
+    }
 }
 
 /// An anytime randomized search (§2.4).
@@ -192,8 +218,9 @@ impl<'g> Search<'g> {
             iterations: 0,
             seed_failures: 0,
         };
-        let mut tries = 0;
         let mut last_reason = String::from("no attempt");
+        let guided_reason = s.add_guided().err();
+        let mut tries = 0;
         while s.population.len() < s.p.seeds.max(1) && tries < s.p.max_seed_tries.max(1) {
             tries += 1;
             match s.seed() {
@@ -205,9 +232,24 @@ impl<'g> Search<'g> {
             }
         }
         if s.population.is_empty() {
-            return Err(Error::NoSeedPath { tries, reason: last_reason });
+            let reason = match guided_reason {
+                Some(g) => format!("{last_reason} (random walks); {g}"),
+                None => last_reason,
+            };
+            return Err(Error::NoSeedPath { tries, reason });
         }
         Ok(s)
+    }
+
+    /// Adds the guided seeds (§13 beam search toward the constraints) to the population.
+    fn add_guided(&mut self) -> std::result::Result<(), String> {
+        let mut rng = self.rng.clone();
+        let r = guided_seeds(self.g, &self.cp, &self.p.guided, self.p.min_piece_frames, &mut rng);
+        self.rng = rng;
+        for sc in r? {
+            self.push(sc);
+        }
+        Ok(())
     }
 
     fn push(&mut self, sc: Scored) {
@@ -265,29 +307,27 @@ impl<'g> Search<'g> {
             }
         };
         let mut next_hard = usize::from(matches!(hard.first(), Some((0, _))));
-        let (mut s, mut a, mut ta) = (start.clip, start.frame, 0u32);
-        let mut min_from = a + minp - 1;
-        let mut cuts = Vec::new();
+        let mut wk = Walk { s: start.clip, a: start.frame, ta: 0, min_from: start.frame + minp - 1, cuts: Vec::new() };
         for _ in 0..10_000 {
-            let len = g.clip_len(s);
+            let len = g.clip_len(wk.s);
             if let Some(&(th, h)) = hard.get(next_hard) {
                 // Staying in this clip reaches t_h at frame a + (t_h − t_a).
-                let fh = a as u64 + (th - ta) as u64;
-                if fh < len as u64 && hard_ok(g, &h, FrameRef { clip: s, frame: fh as u32 }) {
+                let fh = wk.a as u64 + (th - wk.ta) as u64;
+                if fh < len as u64 && hard_ok(g, &h, FrameRef { clip: wk.s, frame: fh as u32 }) {
                     next_hard += 1;
-                    min_from = min_from.max(fh as u32);
+                    wk.min_from = wk.min_from.max(fh as u32);
                     continue;
                 }
-                if th - ta <= self.p.landing_window {
+                if th - wk.ta <= self.p.landing_window {
                     // Land exactly: a leaf (s, i) → (c, j) putting a matching frame at t_h.
                     let mut land = Vec::new();
-                    for &e in &g.out_leaf[s as usize] {
+                    for &e in &g.out_leaf[wk.s as usize] {
                         let n = &g.edges[e as usize];
                         let i = n.from.frame;
-                        if i < min_from {
+                        if i < wk.min_from {
                             continue;
                         }
-                        let tn = ta + (i - a) + 1;
+                        let tn = wk.ta + (i - wk.a) + 1;
                         if tn > th {
                             break;
                         }
@@ -297,62 +337,49 @@ impl<'g> Search<'g> {
                         }
                     }
                     if let Some(e) = self.pick(&land) {
-                        let n = g.edges[e as usize];
-                        ta += n.from.frame - a + 1;
-                        s = n.to.clip;
-                        a = n.to.frame;
-                        cuts.push(e);
-                        let f = a + (th - ta);
-                        min_from = (a + minp - 1).max(f);
+                        wk.follow(g, e, minp);
+                        let f = wk.a + (th - wk.ta);
+                        wk.min_from = wk.min_from.max(f);
                         next_hard += 1;
                         continue;
                     }
                 }
                 // Random step that does not overshoot t_h.
-                let limit = a as u64 + (th - ta) as u64;
-                let outs: Vec<EdgeId> = g.out_top[s as usize]
+                let limit = wk.a as u64 + (th - wk.ta) as u64;
+                let outs: Vec<EdgeId> = g.out_top[wk.s as usize]
                     .iter()
                     .copied()
                     .filter(|&e| {
                         let fr = g.edges[e as usize].from.frame;
-                        fr >= min_from && (fr as u64) < limit
+                        fr >= wk.min_from && (fr as u64) < limit
                     })
                     .collect();
                 let Some(e) = self.pick(&outs) else {
                     return Err(format!("dead end before the hard constraint at frame {th}"));
                 };
-                let n = g.edges[e as usize];
-                ta += n.from.frame - a + 1;
-                s = n.to.clip;
-                a = n.to.frame;
-                min_from = a + minp - 1;
-                cuts.push(e);
+                wk.follow(g, e, minp);
                 continue;
             }
             // No hard constraint pending: end when the length can be met.
-            let remaining = target.saturating_sub(ta);
-            if a + remaining <= len && remaining >= 1 && a + remaining > min_from {
-                let path = Path { start, cuts, end_frame: a + remaining - 1 };
+            let remaining = target.saturating_sub(wk.ta);
+            if wk.a + remaining <= len && remaining >= 1 && wk.a + remaining > wk.min_from {
+                let path = Path { start, cuts: wk.cuts, end_frame: wk.a + remaining - 1 };
                 return score(g, &self.cp, &path, minp).ok_or_else(|| "seed failed validation".to_string());
             }
-            let outs: Vec<EdgeId> =
-                g.out_top[s as usize].iter().copied().filter(|&e| g.edges[e as usize].from.frame >= min_from).collect();
+            let outs: Vec<EdgeId> = g.out_top[wk.s as usize]
+                .iter()
+                .copied()
+                .filter(|&e| g.edges[e as usize].from.frame >= wk.min_from)
+                .collect();
             match self.pick(&outs) {
-                Some(e) if ta < target => {
-                    let n = g.edges[e as usize];
-                    ta += n.from.frame - a + 1;
-                    s = n.to.clip;
-                    a = n.to.frame;
-                    min_from = a + minp - 1;
-                    cuts.push(e);
-                }
+                Some(e) if wk.ta < target => wk.follow(g, e, minp),
                 _ => {
                     // Cannot continue: end as close to the target as the clip allows.
-                    if min_from > len - 1 {
+                    if wk.min_from > len - 1 {
                         return Err("clip too short to end".into());
                     }
-                    let end = (a + remaining.max(1) - 1).clamp(min_from, len - 1);
-                    let path = Path { start, cuts, end_frame: end };
+                    let end = (wk.a + remaining.max(1) - 1).clamp(wk.min_from, len - 1);
+                    let path = Path { start, cuts: wk.cuts, end_frame: end };
                     return score(g, &self.cp, &path, minp).ok_or_else(|| "seed failed validation".to_string());
                 }
             }
@@ -387,6 +414,14 @@ impl<'g> Search<'g> {
         let n = path.cuts.len();
         let mut out = Reservoir { cap: self.p.max_mutations.max(1), seen: 0, items: Vec::new(), rng };
         // (a) replace cuts[i..k] (k − i ≤ max_span; k = i is an insertion into a piece).
+        // One-edge fills: per range, the top edges A → B leaving late enough (a suffix of
+        // `pair_top`, sorted by `from`); when they outnumber the candidate cap they are drawn
+        // uniformly over all ranges instead of enumerated (profiling showed the enumeration, not
+        // the scoring, dominating an iteration).
+        let from_ok =
+            |es: &[EdgeId], min_from1: u32| es.partition_point(|&e| g.edges[e as usize].from.frame + 1 < min_from1);
+        let mut one: Vec<(usize, usize, &[EdgeId], u32)> = Vec::new();
+        let mut total = 0usize;
         for i in 0..=n {
             for k in i..=(i + self.p.max_span).min(n) {
                 let (ca, a0, cb, b1) = self.hole(path, i, k);
@@ -395,29 +430,60 @@ impl<'g> Search<'g> {
                     out.offer(Cand { i, k, with: Fill::of(&[]), start: None, end: None });
                 }
                 if let Some(es) = g.pair_top.get(&(ca, cb)) {
-                    for &e in es {
-                        let nd = &g.edges[e as usize];
-                        if nd.from.frame + 1 >= a0 + minp && nd.to.frame + minp <= b1 + 1 {
-                            out.offer(Cand { i, k, with: Fill::of(&[e]), start: None, end: None });
-                        }
+                    let es = &es[from_ok(es, a0 + minp)..];
+                    if !es.is_empty() {
+                        total += es.len();
+                        one.push((i, k, es, b1));
                     }
                 }
-                // Two-edge fills A → u → B: the first edge is drawn (`TWO_HOP_DRAWS` per range)
-                // among the top edges leaving A late enough; every matching second edge is offered.
+                // Two-edge fills A → u → B: `TWO_HOP_DRAWS` first edges among the top edges
+                // leaving A late enough, and for each at most `TWO_HOP_DRAWS` second edges.
                 let outs = &g.out_top[ca as usize];
-                let lo = outs.partition_point(|&e| g.edges[e as usize].from.frame + 1 < a0 + minp);
+                let lo = from_ok(outs, a0 + minp);
                 let avail = outs.len() - lo;
                 for _ in 0..TWO_HOP_DRAWS.min(avail) {
                     let e1 = outs[lo + out.rng.below(avail)];
                     let n1 = &g.edges[e1 as usize];
-                    if let Some(es) = g.pair_top.get(&(n1.to.clip, cb)) {
+                    let Some(es) = g.pair_top.get(&(n1.to.clip, cb)) else { continue };
+                    let es = &es[from_ok(es, n1.to.frame + minp)..];
+                    let offer2 = |e2: EdgeId, out: &mut Reservoir| {
+                        if g.edges[e2 as usize].to.frame + minp <= b1 + 1 {
+                            out.offer(Cand { i, k, with: Fill::of(&[e1, e2]), start: None, end: None });
+                        }
+                    };
+                    if es.len() <= TWO_HOP_DRAWS {
                         for &e2 in es {
-                            let n2 = &g.edges[e2 as usize];
-                            if n2.from.frame + 1 >= n1.to.frame + minp && n2.to.frame + minp <= b1 + 1 {
-                                out.offer(Cand { i, k, with: Fill::of(&[e1, e2]), start: None, end: None });
-                            }
+                            offer2(e2, &mut out);
+                        }
+                    } else {
+                        for _ in 0..TWO_HOP_DRAWS {
+                            let e2 = es[out.rng.below(es.len())];
+                            offer2(e2, &mut out);
                         }
                     }
+                }
+            }
+        }
+        let offer1 = |i: usize, k: usize, e: EdgeId, b1: u32, out: &mut Reservoir| {
+            if g.edges[e as usize].to.frame + minp <= b1 + 1 {
+                out.offer(Cand { i, k, with: Fill::of(&[e]), start: None, end: None });
+            }
+        };
+        if total <= out.cap {
+            for &(i, k, es, b1) in &one {
+                for &e in es {
+                    offer1(i, k, e, b1, &mut out);
+                }
+            }
+        } else {
+            for _ in 0..out.cap {
+                let mut r = out.rng.below(total);
+                for &(i, k, es, b1) in &one {
+                    if r < es.len() {
+                        offer1(i, k, es[r], b1, &mut out);
+                        break;
+                    }
+                    r -= es.len();
                 }
             }
         }
@@ -559,6 +625,9 @@ impl<'g> Search<'g> {
             }
         }
         self.population = next;
+        if self.p.guided.every > 0 && self.iterations.is_multiple_of(self.p.guided.every) {
+            let _ = self.add_guided();
+        }
         for _ in 0..self.p.new_seeds_per_iter {
             match self.seed() {
                 Ok(s) => self.push(s),
@@ -597,6 +666,7 @@ impl<'g> Search<'g> {
             }
             if self.population.is_empty() {
                 // Everything converged: restart from fresh seeds (anytime search).
+                let _ = self.add_guided();
                 for _ in 0..self.p.seeds.max(1) {
                     if let Ok(s) = self.seed() {
                         self.push(s);
@@ -646,6 +716,7 @@ impl<'g> Search<'g> {
                 self.push(s);
             }
         }
+        let _ = self.add_guided();
         while self.population.len() < self.p.seeds {
             match self.seed() {
                 Ok(s) => self.push(s),

@@ -15,7 +15,9 @@ use std::time::Instant;
 
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use faer::Mat;
-use geom_core::linalg::{dense, Csc, Csr, LltSymbolic, Ordering, Regularization, SparseLdlt, SparseLlt, Triplets};
+use geom_core::linalg::{
+    dense, BorderedLlt, Csc, Csr, LltSymbolic, Ordering, Regularization, SparseLdlt, SparseLlt, Triplets,
+};
 use geom_core::math::{Pt3, Vec3};
 use geom_core::NONE;
 use shells::{ImplicitSystem, VelocitySolve};
@@ -29,12 +31,22 @@ pub enum KktMethod {
     /// A-block in the AMD order of the untracked LLᵀ, multipliers last, LDLᵀ with sign guard.
     #[default]
     ConstraintLastLdlt,
+    /// Our addition: the untracked AMD order of the A-block with each multiplier row inserted
+    /// right after the last DOF of its support, LDLᵀ with sign guard (no shift). Every pivot of a
+    /// multiplier is then −ĉ A₁₁⁻¹ ĉᵀ-like (negative, the constraint-last argument applied to the
+    /// leading block), and local regions are eliminated locally instead of filling a dense
+    /// trailing 3K × 3K block.
+    InterleavedLdlt,
     /// AMD on the whole KKT pattern, (2,2) block −δ·max diag(A)·I, refinement on the exact KKT.
     AmdRegularizedLdlt {
         /// Quasi-definite shift relative to max diag(A) (default 1e-8).
         delta: f64,
     },
-    /// Schur complement S = ĈA⁻¹Ĉᵀ (dense) through the LLᵀ of A with the untracked analysis.
+    /// Schur complement S = ĈA⁻¹Ĉᵀ (dense) through LLᵀ only: one sparse LLᵀ of the SPD bordered
+    /// matrix [A Ĉᵀ; Ĉ γI] in the untracked order of A with the multipliers last (its leading
+    /// block is the untracked factor L_A, its border rows Y = L_A⁻¹ΠĈᵀ are the sparse-RHS
+    /// triangular solves of the spec), S = γI − L₂₂L₂₂ᵀ, dense Cholesky of S, two sparse solves
+    /// (geom-core's `BorderedLlt`). Avoids faer's LDLᵀ, which costs ~2× its LLᵀ here.
     Schur,
     /// The Schur system S μ = ĈA⁻¹b − r solved by preconditioned CG, each iteration one LLᵀ solve,
     /// preconditioned with the dense Cholesky of an S computed exactly at an earlier step (lagged);
@@ -74,6 +86,20 @@ pub struct KktStats {
     pub guide_held: bool,
     /// Stored entries of the factor (LDLᵀ or LLᵀ).
     pub nnz_l: usize,
+    /// Per method of `TrackOptions::compare`: wall time of its solve of the same system (s),
+    /// max |Δv − Δv_main| / max |Δv_main|, and its factor's stored entries.
+    pub compare: Vec<CompareStats>,
+}
+
+/// One alternative method's solve of the same system as the main solve (timing comparison).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CompareStats {
+    /// Wall time of the solve (s), same scope as [`KktStats::t_kkt`].
+    pub t_solve: f64,
+    /// max |Δv − Δv_main| / max |Δv_main|.
+    pub rel_diff: f64,
+    /// Stored entries of its factor.
+    pub nnz_l: usize,
 }
 
 struct KktCache {
@@ -82,7 +108,14 @@ struct KktCache {
     exact: Csc,
     factor_mat: Option<Csc>,
     a_map: Vec<usize>,
-    ldlt: SparseLdlt,
+    /// The LDLᵀ (ConstraintLast, Interleaved, AmdRegularized, Compliant) or the bordered LLᵀ
+    /// (Schur).
+    factor: KktFactor,
+}
+
+enum KktFactor {
+    Ldlt(SparseLdlt),
+    Bordered(Box<BorderedLlt>),
 }
 
 /// The constrained velocity solve, plugged into [`shells::ShellSim::step_with`].
@@ -104,6 +137,8 @@ pub struct TrackingSolver {
     /// Lagged dense Cholesky of S (SchurPcg) and whether to refresh it at the next step.
     lagged_s: Option<dense::DenseLlt>,
     refresh_s: bool,
+    /// Solvers of `TrackOptions::compare`, run on every system after the main solve.
+    shadows: Vec<TrackingSolver>,
     gbuf: Vec<Pt3>,
     /// Statistics of the last solve.
     pub last: KktStats,
@@ -125,7 +160,16 @@ impl TrackingSolver {
         a_symbolic: LltSymbolic,
     ) -> Self {
         let nb = guide.n_vertices();
+        let shadows = opts
+            .compare
+            .iter()
+            .map(|&kkt| {
+                let o = crate::tracker::TrackOptions { kkt, shadow_timing: false, compare: Vec::new(), ..opts.clone() };
+                Self::new(cons.clone(), guide.clone(), &o, a_perm.clone(), a_symbolic.clone())
+            })
+            .collect();
         Self {
+            shadows,
             cons,
             guide,
             method: opts.kkt,
@@ -154,6 +198,15 @@ impl TrackingSolver {
     /// The method.
     pub fn method(&self) -> KktMethod {
         self.method
+    }
+
+    /// (Δv, μ) of the KKT system with right-hand side `r` by this solver's method.
+    fn solve_method(&mut self, sys: &ImplicitSystem, r: &[f64]) -> shells::Result<(Vec<f64>, Vec<f64>)> {
+        match self.method {
+            KktMethod::SchurPcg { refresh_iters } => self.solve_schur_pcg(sys, r, refresh_iters),
+            KktMethod::Penalty { stiffness } => self.solve_penalty(sys, r, stiffness),
+            _ => self.solve_kkt(sys, r),
+        }
     }
 
     fn build_cft(&mut self, sys: &ImplicitSystem) {
@@ -235,14 +288,20 @@ impl TrackingSolver {
                 p.extend(n..n + m);
                 Ordering::Custom(p)
             }
+            KktMethod::InterleavedLdlt => Ordering::Custom(interleaved_order(&self.a_perm, cft, m)),
             _ => Ordering::Amd,
         };
-        let ldlt = SparseLdlt::analyze(&exact, ordering).map_err(core)?;
+        let factor = match self.method {
+            KktMethod::Schur => {
+                KktFactor::Bordered(Box::new(BorderedLlt::analyze(&exact, n, &self.a_perm).map_err(core)?))
+            }
+            _ => KktFactor::Ldlt(SparseLdlt::analyze(&exact, ordering).map_err(core)?),
+        };
         let factor_mat = match self.method {
             KktMethod::AmdRegularizedLdlt { .. } | KktMethod::Compliant { .. } => Some(exact.clone()),
             _ => None,
         };
-        self.kkt = Some(KktCache { n, m, exact, factor_mat, a_map, ldlt });
+        self.kkt = Some(KktCache { n, m, exact, factor_mat, a_map, factor });
         Ok(())
     }
 
@@ -281,27 +340,62 @@ impl TrackingSolver {
                 fv[p] = -shift;
             }
         }
+        let mut rhs = sys.b.to_vec();
+        rhs.extend_from_slice(r);
+        let ldlt = match &mut kkt.factor {
+            KktFactor::Bordered(bf) => {
+                let min_diag = (0..n)
+                    .map(|j| {
+                        let s = sys.a.symbolic();
+                        s.col_range(j).find(|&k| s.row_idx()[k] == j).map_or(f64::INFINITY, |k| av[k])
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                // First γ: rows have unit sums, so S_ii ≲ 1/λ_min(A) ~ 1/min diag(A) (a guess;
+                // BorderedLlt retries with 4γ when it is too small).
+                bf.factor(&kkt.exact, 4.0 / min_diag.max(1e-300)).map_err(core)?;
+                let (mut x, mut mu) = bf.solve(sys.b, r).map_err(core)?;
+                let mut res = f64::NAN;
+                for it in 0..=refine {
+                    let mut sol = x.clone();
+                    sol.extend_from_slice(&mu);
+                    let mut kx = vec![0.0; n + m];
+                    geom_core::linalg::sym_mul_vec(&kkt.exact, &sol, &mut kx);
+                    let d: Vec<f64> = rhs.iter().zip(&kx).map(|(a, b)| a - b).collect();
+                    let norm = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    res = norm(&d) / norm(&rhs).max(1e-300);
+                    if it == refine {
+                        break;
+                    }
+                    let (dx, dmu) = bf.solve(&d[..n], &d[n..]).map_err(core)?;
+                    x.iter_mut().zip(&dx).for_each(|(a, b)| *a += b);
+                    mu.iter_mut().zip(&dmu).for_each(|(a, b)| *a += b);
+                }
+                self.last.refinement_residual = res;
+                self.last.nnz_l = bf.nnz_l();
+                return Ok((x, mu));
+            }
+            KktFactor::Ldlt(l) => l,
+        };
         let mut reg = Regularization::kkt(n, m);
         reg.eps = 1e-13 * max_diag;
         reg.delta = 1e-8 * max_diag.max(1e-300);
         let fmat = kkt.factor_mat.as_ref().unwrap_or(&kkt.exact);
-        kkt.ldlt.factor(fmat, &reg).map_err(core)?;
-        let mut rhs = sys.b.to_vec();
-        rhs.extend_from_slice(r);
+        ldlt.factor(fmat, &reg).map_err(core)?;
         let mut x = vec![0.0; n + m];
         let res = match method {
-            KktMethod::Compliant { .. } => kkt.ldlt.solve_refined(fmat, &rhs, &mut x, 0),
-            KktMethod::AmdRegularizedLdlt { .. } => kkt.ldlt.solve_refined(&kkt.exact, &rhs, &mut x, refine.max(2)),
-            _ => kkt.ldlt.solve_refined(&kkt.exact, &rhs, &mut x, refine),
+            KktMethod::Compliant { .. } => ldlt.solve_refined(fmat, &rhs, &mut x, 0),
+            KktMethod::AmdRegularizedLdlt { .. } => ldlt.solve_refined(&kkt.exact, &rhs, &mut x, refine.max(2)),
+            _ => ldlt.solve_refined(&kkt.exact, &rhs, &mut x, refine),
         }
         .map_err(core)?;
         self.last.refinement_residual = res;
-        self.last.nnz_l = kkt.ldlt.nnz_l();
+        self.last.nnz_l = ldlt.nnz_l();
         let mu = x.split_off(n);
         Ok((x, mu))
     }
 
-    fn solve_schur(&mut self, sys: &ImplicitSystem, r: &[f64]) -> shells::Result<(Vec<f64>, Vec<f64>)> {
+    /// Exact S by 3K dense-RHS solves with the LLᵀ of A (SchurPcg's refresh of its lagged S).
+    fn solve_schur_dense(&mut self, sys: &ImplicitSystem, r: &[f64]) -> shells::Result<(Vec<f64>, Vec<f64>)> {
         let n = sys.a.nrows();
         let m = 3 * self.cons.len();
         let llt = self.llt.get_or_insert_with(|| SparseLlt::from_symbolic(&self.a_symbolic));
@@ -365,7 +459,7 @@ impl TrackingSolver {
         let m = 3 * self.cons.len();
         if self.refresh_s || self.lagged_s.is_none() {
             // Exact S at this step (3K solves) and its dense Cholesky; then the solve is direct.
-            let (dv, mu) = self.solve_schur(sys, r)?;
+            let (dv, mu) = self.solve_schur_dense(sys, r)?;
             self.refresh_s = false;
             return Ok((dv, mu));
         }
@@ -474,6 +568,37 @@ impl TrackingSolver {
     }
 }
 
+/// The A-block order `a_perm` (`perm[new] = old`, length n) with multiplier row `n + r` inserted
+/// right after the last DOF of its support (`cft`: per free vertex, its constraints), so each
+/// multiplier is eliminated as soon as its whole support is (see [`KktMethod::InterleavedLdlt`]).
+fn interleaved_order(a_perm: &[usize], cft: &[Vec<(u32, f64)>], m: usize) -> Vec<usize> {
+    let n = a_perm.len();
+    let mut pos = vec![0usize; n];
+    for (k, &j) in a_perm.iter().enumerate() {
+        pos[j] = k;
+    }
+    // last[r]: position in a_perm of the last support DOF of multiplier row r.
+    let mut last = vec![0usize; m];
+    for (f, row) in cft.iter().enumerate() {
+        for &(i, _) in row {
+            for d in 0..3 {
+                let r = 3 * i as usize + d;
+                last[r] = last[r].max(pos[3 * f + d]);
+            }
+        }
+    }
+    let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (r, &k) in last.iter().enumerate() {
+        after[k].push(r);
+    }
+    let mut p = Vec::with_capacity(n + m);
+    for (k, &j) in a_perm.iter().enumerate() {
+        p.push(j);
+        p.extend(after[k].iter().map(|&r| n + r));
+    }
+    p
+}
+
 impl VelocitySolve for TrackingSolver {
     fn solve(&mut self, sys: &ImplicitSystem) -> shells::Result<Vec<f64>> {
         let t0 = Instant::now();
@@ -484,12 +609,7 @@ impl VelocitySolve for TrackingSolver {
         self.cons.residual(&self.gbuf, sys.q_pred, &mut g);
         let c = self.correction_fraction / sys.h_eff;
         let r: Vec<f64> = g.iter().flat_map(|gi| [c * gi.x, c * gi.y, c * gi.z]).collect();
-        let (dv, mu) = match self.method {
-            KktMethod::Schur => self.solve_schur(sys, &r)?,
-            KktMethod::SchurPcg { refresh_iters } => self.solve_schur_pcg(sys, &r, refresh_iters)?,
-            KktMethod::Penalty { stiffness } => self.solve_penalty(sys, &r, stiffness)?,
-            _ => self.solve_kkt(sys, &r)?,
-        };
+        let (dv, mu) = self.solve_method(sys, &r)?;
         self.last.t_kkt = t0.elapsed().as_secs_f64();
         // Residual before collisions: g(q⁰ + h_eff Δv) on every vertex (constrained ones at q⁰).
         let mut q_end = sys.q_pred.to_vec();
@@ -507,6 +627,17 @@ impl VelocitySolve for TrackingSolver {
             llt.factor(sys.a).map_err(core)?;
             self.last.t_shadow_llt = ts.elapsed().as_secs_f64();
         }
+        let scale = dv.iter().fold(0.0f64, |a, x| a.max(x.abs())).max(1e-300);
+        let mut compare = Vec::with_capacity(self.shadows.len());
+        for sh in &mut self.shadows {
+            let ts = Instant::now();
+            sh.build_cft(sys);
+            let (dvs, _) = sh.solve_method(sys, &r)?;
+            let t_solve = ts.elapsed().as_secs_f64();
+            let diff = dvs.iter().zip(&dv).fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+            compare.push(CompareStats { t_solve, rel_diff: diff / scale, nnz_l: sh.last.nnz_l });
+        }
+        self.last.compare = compare;
         Ok(dv)
     }
 }

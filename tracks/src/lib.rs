@@ -29,6 +29,6 @@ pub use cluster::{cluster, ClusterInit, ClusterMetric, ClusterOptions, Clusterin
 pub use constraints::{pg_mass_matrix, GramFactor, TrackingConstraints};
 pub use error::{Result, TrackError};
 pub use guide::{GuideAnimation, ProceduralFn, TimeInterp};
-pub use kkt::{KktMethod, KktStats, TrackingSolver};
+pub use kkt::{CompareStats, KktMethod, KktStats, TrackingSolver};
 pub use testfn::{build_test_functions, RegionSel, TestFunctionSpec, TestFunctions, TestKind};
 pub use tracker::{TrackOptions, TrackStepStats, Tracker};

@@ -28,6 +28,10 @@ pub struct TrackOptions {
     pub refine_steps: u32,
     /// Also time an unused LLᵀ of A each step (solve-overhead attribution).
     pub shadow_timing: bool,
+    /// Also solve every step's system with each of these methods (results unused, timed and
+    /// compared with the main solve): measures the alternatives on identical matrices in one
+    /// run (spec §3.6, issue 4). Costs their time; keep empty in overhead runs.
+    pub compare: Vec<KktMethod>,
 }
 
 impl Default for TrackOptions {
@@ -38,6 +42,7 @@ impl Default for TrackOptions {
             correction_fraction: 1.0,
             refine_steps: 1,
             shadow_timing: false,
+            compare: Vec::new(),
         }
     }
 }
@@ -65,6 +70,8 @@ pub struct TrackStepStats {
     pub guide_held: bool,
     /// Stored entries of the factor used by the constrained solve.
     pub nnz_l: usize,
+    /// Per method of [`TrackOptions::compare`]: its solve of the same system.
+    pub compare: Vec<crate::kkt::CompareStats>,
 }
 
 /// A tracked simulation.
@@ -235,6 +242,7 @@ impl Tracker {
                 out.kkt_refinement_residual = l.refinement_residual;
                 out.guide_held = l.guide_held;
                 out.nnz_l = l.nnz_l;
+                out.compare = l.compare.clone();
             }
         }
         out.t_step = t0.elapsed().as_secs_f64();

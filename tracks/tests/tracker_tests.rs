@@ -60,7 +60,12 @@ fn tracker(method: KktMethod, levels: u32) -> (Tracker, f64) {
 /// §7.8 (collisions off): r_pre = r_post ≤ 1e-10·L at every step for every exact method.
 #[test]
 fn residual_every_step() {
-    for m in [KktMethod::ConstraintLastLdlt, KktMethod::AmdRegularizedLdlt { delta: 1e-8 }, KktMethod::Schur] {
+    for m in [
+        KktMethod::ConstraintLastLdlt,
+        KktMethod::InterleavedLdlt,
+        KktMethod::AmdRegularizedLdlt { delta: 1e-8 },
+        KktMethod::Schur,
+    ] {
         let (mut tr, l) = tracker(m, 2);
         assert!(tr.residual_now() <= 1e-12 * l, "initial state consistent");
         for _ in 0..60 {
@@ -75,7 +80,12 @@ fn residual_every_step() {
 #[test]
 fn kkt_methods_agree() {
     let mut states = Vec::new();
-    for m in [KktMethod::ConstraintLastLdlt, KktMethod::AmdRegularizedLdlt { delta: 1e-8 }, KktMethod::Schur] {
+    for m in [
+        KktMethod::ConstraintLastLdlt,
+        KktMethod::InterleavedLdlt,
+        KktMethod::AmdRegularizedLdlt { delta: 1e-8 },
+        KktMethod::Schur,
+    ] {
         let (mut tr, _) = tracker(m, 2);
         for _ in 0..5 {
             tr.step(1.0 / 60.0).expect("step");
@@ -306,5 +316,27 @@ fn physical_guide_is_free() {
         assert!(s.max_constraint_force <= 1e-6, "force {}", s.max_constraint_force);
         let d = tr.sim.state().q.iter().zip(f).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
         assert!(d <= 1e-8 * l, "deviation {d}");
+    }
+}
+
+/// `TrackOptions::compare`: every alternative solves the same systems as the main method, is
+/// timed, and agrees with it (1e-9 relative on Δv; the factorisations differ in rounding only).
+#[test]
+fn compare_methods_on_identical_systems() {
+    let c = coarse();
+    let (fine, p) = subdivide_linear(&c, 2);
+    let g = waving_guide(&c);
+    let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
+    let sim = sim_of(&fine, true, 0.0, vec![], Vec3::zeros());
+    let compare = vec![KktMethod::InterleavedLdlt, KktMethod::Schur, KktMethod::AmdRegularizedLdlt { delta: 1e-8 }];
+    let opts = TrackOptions { compare: compare.clone(), ..TrackOptions::default() };
+    let mut tr = Tracker::new(sim, g, tf, Some(p), opts).expect("tracker");
+    for _ in 0..3 {
+        let s = tr.step(1.0 / 60.0).expect("step");
+        assert_eq!(s.compare.len(), compare.len());
+        for (m, c) in compare.iter().zip(&s.compare) {
+            assert!(c.t_solve > 0.0 && c.nnz_l > 0, "{m:?} timed");
+            assert!(c.rel_diff <= 1e-9, "{m:?} differs by {}", c.rel_diff);
+        }
     }
 }

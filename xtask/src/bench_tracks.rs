@@ -7,7 +7,7 @@
 use crate::error::Result;
 use crate::out::Summary;
 use crate::registry::BenchCtx;
-use crate::scenes::tracks::{partition_study, write_partition_outputs};
+use crate::scenes::tracks::{partition_keys, partition_study, write_partition_outputs};
 use tracks::KktMethod;
 
 /// Runs the sweep (quick: 16/64/256 regions, 3 frames; full: 16 … 1024, 1 s).
@@ -27,14 +27,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     )?;
     write_partition_outputs(&rows, &ctx.out_dir)?;
     let mut s = Summary::new();
-    for r in &rows {
-        s.set(&format!("deviation_r{}", r.regions), r.deviation);
-        s.set(&format!("wavelength_m_r{}", r.regions), r.wavelength);
-        s.set(&format!("s_per_frame_r{}", r.regions), r.s_per_frame);
-        s.set(&format!("overhead_pct_r{}", r.regions), r.overhead_pct);
-        s.set(&format!("overhead_pct_median_step_r{}", r.regions), r.overhead_pct_median);
-        s.set(&format!("max_residual_pre_r{}", r.regions), r.r_pre);
-    }
+    partition_keys(&rows, &mut s);
     s.set("s_per_frame_untracked", rows.iter().map(|r| r.s_per_frame_untracked).sum::<f64>() / rows.len() as f64);
     s.set("duration_s", duration);
     Ok(s)

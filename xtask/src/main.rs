@@ -4,6 +4,7 @@
 
 mod bench_barnet;
 mod bench_curve_skin;
+mod bench_flip_tet;
 mod bench_geom_core;
 mod bench_motion_graph;
 mod bench_rigging;

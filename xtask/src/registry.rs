@@ -60,6 +60,8 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::curve_skin::register(&mut v);
     crate::scenes::rigging::register(&mut v);
     crate::scenes::motion_graph::register(&mut v);
+    crate::scenes::flip_tet::register(&mut v);
+    crate::scenes::flip_tet_adaptive::register(&mut v);
     v
 }
 
@@ -100,6 +102,11 @@ pub fn benches() -> Vec<Bench> {
             crate_name: "motion-graph",
             description: "motion graphs: search budget vs constraint error (hierarchy on/off), graph density, database size, smoothing window",
             run: crate::bench_motion_graph::run,
+        },
+        Bench {
+            crate_name: "flip-tet",
+            description: "flip-tet: resolution, adaptivity levels, solver tolerance and boundary order vs dam-break front error, rest speed and time",
+            run: crate::bench_flip_tet::run,
         },
     ]
 }

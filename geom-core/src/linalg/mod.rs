@@ -17,6 +17,7 @@
 //! bitwise identical for any thread count; the direct factorisations run with `faer::Par::Seq`
 //! by default for the same reason (opt into Rayon with `set_par`).
 
+mod bordered;
 mod cg;
 mod csc;
 mod csr;
@@ -30,6 +31,7 @@ mod symbolic;
 mod triplets;
 mod vector;
 
+pub use bordered::BorderedLlt;
 pub use cg::{pcg, CgOptions, CgReport};
 pub use csc::{rel_residual, sym_mul_vec, Csc};
 pub use csr::{Csr, PAR_ROWS};

@@ -19,8 +19,8 @@ use geom_core::io::{obj, MeshOut};
 use geom_core::math::{Planar, Vec3};
 use geom_core::rng::Rng;
 use motion_graph::{
-    assemble, enforce_body, evaluate, smooth, BodyConstraint, ClipStats, Database, DbParams, FrameRef, GraphParams,
-    HardConstraint, JointConstraint, MotionGraph, Problem, Search, SearchParams, Tolerance, Weights,
+    assemble, enforce_body, evaluate, fix_contacts, smooth, BodyConstraint, ClipStats, Database, DbParams, FrameRef,
+    GraphParams, HardConstraint, JointConstraint, MotionGraph, Problem, Search, SearchParams, Tolerance, Weights,
 };
 use serde::Deserialize;
 
@@ -127,6 +127,14 @@ pub struct Params {
     /// Report the distance between the first two characters at this frame (MG-5).
     #[serde(default)]
     pub pair_distance_at: Option<u32>,
+    /// Cancel contact sliding by root translation before §3.11 (`motion_graph::fix_contacts`;
+    /// default on).
+    #[serde(default = "default_true")]
+    pub contact_fix: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 fn load_db(spec: &DbSpec, mode: Mode) -> Result<Database> {
@@ -275,6 +283,7 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
     let mut err_after = Vec::new();
     let mut jv_after = Vec::new();
     let mut skate = Vec::new();
+    let mut skate_plain = Vec::new();
     let mut hard_total = 0usize;
     let mut hard_met = 0usize;
     let mut pieces = Vec::new();
@@ -342,6 +351,13 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
             path_len / m.duration().max(1e-9)
         };
         speeds.push(speed);
+        // Skate without the contact fix, for comparison (same §3.11 correction).
+        let mut plain = a.clone();
+        enforce_body(&mut plain, &pb.body);
+        skate_plain.push(evaluate(&g, &plain, pb).skate.rate_cm_s);
+        if p.contact_fix {
+            fix_contacts(&mut a);
+        }
         enforce_body(&mut a, &pb.body);
         let after = evaluate(&g, &a, pb);
         for (i, b) in pb.body.iter().enumerate() {
@@ -431,6 +447,7 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
     );
     sum.set("foot_skate_cm_s", percentile(&skate, 50.0));
     sum.set("foot_skate_cm_s_max", skate.iter().copied().fold(0.0, f64::max));
+    sum.set("foot_skate_cm_s_without_contact_fix", percentile(&skate_plain, 50.0));
     sum.set("source_skate_cm_s", clip_stats.skate.rate_cm_s);
     sum.set("pieces_median", percentile(&pieces, 50.0));
     sum.set("mean_speed_m_s", percentile(&speeds, 50.0));

@@ -65,33 +65,56 @@ fn core<T>(r: geom_core::Result<T>) -> Result<T> {
 // ---------------------------------------------------------------------------------------------
 // materials (ours; the seed names the materials only)
 
-fn rubber() -> Material {
+/// Isotropic St Venant–Kirchhoff shell: areal density (kg/m²), Young's modulus × thickness (N/m),
+/// Poisson ratio, bending stiffness (N·m) and Rayleigh stiffness damping β (s).
+fn iso_material(density: f64, young_thickness: f64, poisson: f64, bending: f64, beta: f64) -> Material {
     Material {
-        density: 0.5,
-        membrane: MembraneLaw::Isotropic { young_thickness: 2.0e4, poisson: 0.4, compression_softening: None },
-        bending: 2e-4,
-        damping: Damping::Rayleigh { alpha: 0.0, beta: 1e-3 },
+        density,
+        membrane: MembraneLaw::Isotropic { young_thickness, poisson, compression_softening: None },
+        bending,
+        damping: Damping::Rayleigh { alpha: 0.0, beta },
         plasticity: None,
     }
+}
+
+fn rubber() -> Material {
+    iso_material(0.5, 2.0e4, 0.4, 2e-4, 1e-3)
 }
 
 fn vinyl() -> Material {
-    Material {
-        density: 0.3,
-        membrane: MembraneLaw::Isotropic { young_thickness: 5.0e3, poisson: 0.35, compression_softening: None },
-        bending: 5e-5,
-        damping: Damping::Rayleigh { alpha: 0.0, beta: 5e-3 },
-        plasticity: None,
-    }
+    iso_material(0.3, 5.0e3, 0.35, 5e-5, 5e-3)
 }
 
 fn xavier_cloth() -> Material {
-    Material {
-        density: 0.2,
-        membrane: MembraneLaw::Isotropic { young_thickness: 3000.0, poisson: 0.3, compression_softening: None },
-        bending: 2e-5,
-        damping: Damping::Rayleigh { alpha: 0.0, beta: 5e-4 },
-        plasticity: None,
+    iso_material(0.2, 3000.0, 0.3, 2e-5, 5e-4)
+}
+
+/// Gravity, the given obstacles and (optionally) self-collision; no wind.
+fn gravity_effects(self_collision: bool, obstacles: Vec<Obstacle>) -> Effects {
+    let any_obstacle = !obstacles.is_empty();
+    Effects {
+        gravity: Some(Vec3::new(0.0, -9.81, 0.0)),
+        obstacles,
+        self_collision,
+        collision: collision(self_collision, any_obstacle),
+        ..Effects::default()
+    }
+}
+
+/// A scene of `mesh` at rest with `material` and `effects`, no constraints, default integrator;
+/// callers override fields with struct-update syntax.
+fn shell_desc(mesh: &TriMesh, material: Material, effects: Effects) -> ShellSceneDesc {
+    ShellSceneDesc {
+        rest: mesh.positions.clone(),
+        faces: mesh.faces.clone(),
+        uv: None,
+        initial: None,
+        initial_velocity: None,
+        material,
+        effects,
+        constraints: vec![],
+        integrator: IntegratorSettings::default(),
+        t0: 0.0,
     }
 }
 
@@ -159,6 +182,9 @@ pub(crate) struct PairOut {
     pub final_untracked: Vec<Pt3>,
     pub ke_tracked: Vec<f64>,
     pub step_times: Vec<(f64, f64)>,
+    /// Per method of `TrackOptions::compare`: Σ solve time (s), max relative Δv difference to
+    /// the main solve, stored factor entries.
+    pub compare: Vec<(f64, f64, usize)>,
 }
 
 impl PairOut {
@@ -265,6 +291,10 @@ pub(crate) fn run_pair(setup: &Setup, o: &PairOpts, out_dir: &Path) -> Result<Pa
                 out.max_force = out.max_force.max(st.max_constraint_force);
                 out.nnz_l = out.nnz_l.max(st.nnz_l);
                 out.guide_held |= st.guide_held;
+                out.compare.resize(st.compare.len(), (0.0, 0.0, 0));
+                for (acc, c) in out.compare.iter_mut().zip(&st.compare) {
+                    *acc = (acc.0 + c.t_solve, acc.1.max(c.rel_diff), acc.2.max(c.nnz_l));
+                }
                 let mut tu = 0.0;
                 if let Some(u) = un.as_mut() {
                     let t0 = Instant::now();
@@ -433,18 +463,12 @@ fn run_standard(
 const FLAG_FPS: f64 = 30.0;
 
 fn flag_effects(self_collision: bool) -> Effects {
-    Effects {
-        gravity: Some(Vec3::new(0.0, -9.81, 0.0)),
-        wind: Some(Wind::steady(Vec3::new(1.5, 0.0, 0.0))),
-        obstacles: vec![Obstacle {
-            shape: ObstacleShape::Capsule { a: Pt3::new(2.0, 1.2, -1.0), b: Pt3::new(2.0, 1.2, 1.0), radius: 0.03 },
-            friction: 0.8,
-            motion: None,
-        }],
-        self_collision,
-        collision: collision(self_collision, true),
-        custom: vec![],
-    }
+    let branch = Obstacle {
+        shape: ObstacleShape::Capsule { a: Pt3::new(2.0, 1.2, -1.0), b: Pt3::new(2.0, 1.2, 1.0), radius: 0.03 },
+        friction: 0.8,
+        motion: None,
+    };
+    Effects { wind: Some(Wind::steady(Vec3::new(1.5, 0.0, 0.0))), ..gravity_effects(self_collision, vec![branch]) }
 }
 
 /// Initial velocity: (v_x, v_y, 0) plus a spin of 1.5 rad/s about z through the flag centre.
@@ -456,16 +480,8 @@ fn flag_velocity(p: &[Pt3], vx: f64, vy: f64) -> Vec<Vec3> {
 
 fn flag_desc(m: &TriMesh, vx: f64, vy: f64, self_collision: bool) -> ShellSceneDesc {
     ShellSceneDesc {
-        rest: m.positions.clone(),
-        faces: m.faces.clone(),
-        uv: None,
-        initial: None,
         initial_velocity: Some(flag_velocity(&m.positions, vx, vy)),
-        material: Material::cotton(),
-        effects: flag_effects(self_collision),
-        constraints: vec![],
-        integrator: IntegratorSettings::default(),
-        t0: 0.0,
+        ..shell_desc(m, Material::cotton(), flag_effects(self_collision))
     }
 }
 
@@ -602,21 +618,8 @@ pub(crate) fn box_setup(substeps: u32, self_collision: bool) -> Result<Setup> {
         prolongation: Some(p),
         tracked_rest: fine,
         desc: Box::new(move || ShellSceneDesc {
-            rest: f2.positions.clone(),
-            faces: f2.faces.clone(),
-            uv: None,
-            initial: None,
-            initial_velocity: None,
-            material: rubber(),
-            effects: Effects {
-                gravity: Some(Vec3::new(0.0, -9.81, 0.0)),
-                self_collision,
-                collision: collision(self_collision, false),
-                ..Effects::default()
-            },
             constraints: vec![VertexConstraint::Pinned(pins.clone())],
-            integrator: IntegratorSettings::default(),
-            t0: 0.0,
+            ..shell_desc(&f2, rubber(), gravity_effects(self_collision, vec![]))
         }),
         tf,
         fps: 30.0,
@@ -667,24 +670,7 @@ pub(crate) fn bag_setup(substeps: u32, self_collision: bool) -> Result<Setup> {
         guide,
         prolongation: Some(p),
         tracked_rest,
-        desc: Box::new(move || ShellSceneDesc {
-            rest: r2.positions.clone(),
-            faces: r2.faces.clone(),
-            uv: None,
-            initial: None,
-            initial_velocity: None,
-            material: vinyl(),
-            effects: Effects {
-                gravity: Some(Vec3::new(0.0, -9.81, 0.0)),
-                obstacles: vec![ground(0.5)],
-                self_collision,
-                collision: collision(self_collision, true),
-                ..Effects::default()
-            },
-            constraints: vec![],
-            integrator: IntegratorSettings::default(),
-            t0: 0.0,
-        }),
+        desc: Box::new(move || shell_desc(&r2, vinyl(), gravity_effects(self_collision, vec![ground(0.5)]))),
         tf,
         fps: 30.0,
         substeps,
@@ -721,14 +707,7 @@ fn xavier_effects(self_collision: bool) -> Effects {
     wind.seed = 7;
     // Switched on over 4–7 s.
     wind.schedule = vec![(3.99, 0.0), (4.0, 1.0), (7.0, 1.0), (7.01, 0.0)];
-    Effects {
-        gravity: Some(Vec3::new(0.0, -9.81, 0.0)),
-        wind: Some(wind),
-        obstacles: vec![ground(0.5)],
-        self_collision,
-        collision: collision(self_collision, true),
-        custom: vec![],
-    }
+    Effects { wind: Some(wind), ..gravity_effects(self_collision, vec![ground(0.5)]) }
 }
 
 pub(crate) fn xavier_setup(
@@ -749,16 +728,8 @@ pub(crate) fn xavier_setup(
         prolongation: None,
         tracked_rest: x.mesh.clone(),
         desc: Box::new(move || ShellSceneDesc {
-            rest: mesh.positions.clone(),
-            faces: mesh.faces.clone(),
-            uv: None,
             initial: Some(g0.clone()),
-            initial_velocity: None,
-            material: xavier_cloth(),
-            effects: xavier_effects(self_collision),
-            constraints: vec![],
-            integrator: IntegratorSettings::default(),
-            t0: 0.0,
+            ..shell_desc(&mesh, xavier_cloth(), xavier_effects(self_collision))
         }),
         tf,
         fps: 30.0,
@@ -827,6 +798,7 @@ fn averaged_vs_pointwise(
     pw_guide: &GuideAnimation,
     fine: &TriMesh,
     pm: &Csr,
+    material_rest: Option<Vec<Pt3>>,
 ) -> Result<(PairOut, PairOut)> {
     let m = ctx.mode;
     let mut mat = rubber();
@@ -834,23 +806,23 @@ fn averaged_vs_pointwise(
     let make = |tf: TestFunctions, guide: &GuideAnimation| -> Setup {
         let f2 = fine.clone();
         let mat = mat.clone();
+        let material_rest = material_rest.clone();
         Setup {
             guide: guide.clone(),
             prolongation: Some(pm.clone()),
             tracked_rest: fine.clone(),
-            desc: Box::new(move || ShellSceneDesc {
-                rest: f2.positions.clone(),
-                faces: f2.faces.clone(),
-                uv: None,
-                initial: None,
-                initial_velocity: None,
-                material: mat.clone(),
-                effects: Effects::default(),
-                constraints: vec![],
-                // The guide pumps energy into the shell: shells' blow-up guard is relative to
-                // the (tiny) initial energy, so it is widened here.
-                integrator: IntegratorSettings { divergence_energy_factor: 1e12, ..IntegratorSettings::default() },
-                t0: 0.0,
+            desc: Box::new(move || {
+                let d = ShellSceneDesc {
+                    // The guide pumps energy into the shell: shells' blow-up guard is relative to
+                    // the (tiny) initial energy, so it is widened here.
+                    integrator: IntegratorSettings { divergence_energy_factor: 1e12, ..IntegratorSettings::default() },
+                    ..shell_desc(&f2, mat.clone(), Effects::default())
+                };
+                match &material_rest {
+                    // Start at `fine`, with the material's rest shape elsewhere (pre-stretched).
+                    Some(r) => ShellSceneDesc { rest: r.clone(), initial: Some(f2.positions.clone()), ..d },
+                    None => d,
+                }
             }),
             tf,
             fps: 30.0,
@@ -891,7 +863,7 @@ fn run_fig3(ctx: &RunCtx) -> Result<Summary> {
     let m = ctx.mode;
     let guide = band_guide()?;
     let (fine, pm) = subdivide_linear(&guide.rest, 3);
-    let (avg, pw) = averaged_vs_pointwise(ctx, &p, &guide, &guide, &fine, &pm)?;
+    let (avg, pw) = averaged_vs_pointwise(ctx, &p, &guide, &guide, &fine, &pm, None)?;
     let frames = avg.frames;
     let window = window_max;
     let mut s = Summary::new();
@@ -922,6 +894,10 @@ struct Fig4Params {
     kkt: KktMethod,
     refine_steps: u32,
     obj_every: usize,
+    /// fig4 only: radius of the tracked material's rest sphere over the guide's rest radius
+    /// (the simulation starts at the guide's radius; absent = 1, the spec's setup).
+    #[serde(default)]
+    tracked_rest_scale: Option<f64>,
 }
 
 fn run_fig4(ctx: &RunCtx) -> Result<Summary> {
@@ -961,7 +937,10 @@ fn run_fig4(ctx: &RunCtx) -> Result<Summary> {
         }),
         3.0,
     ))?;
-    let (avg, pw) = averaged_vs_pointwise(ctx, &p, &avg_guide, &guide, &fine, &pm)?;
+    // The material's rest sphere: `tracked_rest_scale` × the guide's rest radius (1 = the spec).
+    let scale = p.tracked_rest_scale.unwrap_or(1.0);
+    let material_rest = (scale != 1.0).then(|| fine.positions.iter().map(|q| Pt3::from(q.coords * scale)).collect());
+    let (avg, pw) = averaged_vs_pointwise(ctx, &p, &avg_guide, &guide, &fine, &pm, material_rest)?;
     let frames = avg.frames;
     let window = window_max;
     let fast = (2.0, 3.0);
@@ -976,6 +955,7 @@ fn run_fig4(ctx: &RunCtx) -> Result<Summary> {
     s.set("bend_energy_ratio_pointwise_over_averaged", eb_pw / eb_avg);
     s.set("bend_energy_max_slow_averaged_J", slow_avg);
     s.set("bend_energy_max_slow_pointwise_J", slow_pw);
+    s.set("tracked_rest_scale", scale);
     s.set("tug_index_pointwise_fast", window(&pw, fast.0, fast.1, &pw.tug_tracked));
     s.set("tug_index_averaged_fast", window(&avg, fast.0, fast.1, &avg.tug_tracked));
     s.set("max_residual_pre_pointwise", pw.max_r_pre / pw.scale);
@@ -1007,6 +987,18 @@ struct Fig6Params {
     kkt_large: KktMethod,
     large_from: usize,
     refine_steps: u32,
+}
+
+/// The per-r keys of the partition study (fig6 and the benchmark).
+pub(crate) fn partition_keys(rows: &[PartitionRow], s: &mut Summary) {
+    for r in rows {
+        s.set(&format!("deviation_r{}", r.regions), r.deviation);
+        s.set(&format!("overhead_pct_r{}", r.regions), r.overhead_pct);
+        s.set(&format!("overhead_pct_median_step_r{}", r.regions), r.overhead_pct_median);
+        s.set(&format!("wavelength_m_r{}", r.regions), r.wavelength);
+        s.set(&format!("s_per_frame_r{}", r.regions), r.s_per_frame);
+        s.set(&format!("max_residual_pre_r{}", r.regions), r.r_pre);
+    }
 }
 
 /// One row of the partition study.
@@ -1148,14 +1140,7 @@ fn run_fig6(ctx: &RunCtx) -> Result<Summary> {
     s.set_count("deviation_monotone", dev_mono as u64);
     s.set_count("overhead_monotone", ovh_mono as u64);
     s.set_count("wavelength_monotone", wl_mono as u64);
-    for r in &rows {
-        s.set(&format!("deviation_r{}", r.regions), r.deviation);
-        s.set(&format!("overhead_pct_r{}", r.regions), r.overhead_pct);
-        s.set(&format!("overhead_pct_median_step_r{}", r.regions), r.overhead_pct_median);
-        s.set(&format!("wavelength_m_r{}", r.regions), r.wavelength);
-        s.set(&format!("s_per_frame_r{}", r.regions), r.s_per_frame);
-        s.set(&format!("max_residual_pre_r{}", r.regions), r.r_pre);
-    }
+    partition_keys(&rows, &mut s);
     s.set("max_residual_pre", rows.iter().map(|r| r.r_pre).fold(0.0, f64::max));
     s.set("duration_s", pick3(m, p.duration));
     s.set_str("mode", m.name());
@@ -1255,10 +1240,14 @@ struct TableParams {
     repeats: (usize, usize, usize),
     /// Self-collision for quick / default / full.
     self_collision: (bool, bool, bool),
-    kkt: KktMethod,
-    /// Solver for the 280-constraint Xavier row (many small regions: AMD-interleaved LDLᵀ).
-    kkt_xavier: KktMethod,
+    /// Saddle-point solver per scene: (flag, box, bag, xavier).
+    kkt: (KktMethod, KktMethod, KktMethod, KktMethod),
     refine_steps: u32,
+    /// Methods timed against each other on identical systems in one extra tracked run per scene
+    /// (with the shadow LLᵀ of A for the solve-overhead column); empty = skip that run.
+    compare: Vec<KktMethod>,
+    /// Simulated time of that run (s) for quick / default / full.
+    compare_duration: (f64, f64, f64),
 }
 
 fn run_table55(ctx: &RunCtx) -> Result<Summary> {
@@ -1303,9 +1292,16 @@ fn run_table55(ctx: &RunCtx) -> Result<Summary> {
     let mut report = String::from(
         "# TRACKS §5.5 table: ours beside the paper\n\n| scene | constraints | s/frame tracked (untracked) | overhead % | paper s/frame | paper overhead % |\n|---|---|---|---|---|---|\n",
     );
+    // Per scene: its KKT method and the untracked ms per step of the kept run.
+    let mut main_runs: Vec<(KktMethod, f64)> = Vec::new();
     for (name, setup, paper_ovh, paper) in &scenes {
         let mut best: Option<PairOut> = None;
-        let kkt = if *name == "xavier" { p.kkt_xavier } else { p.kkt };
+        let kkt = match *name {
+            "flag" => p.kkt.0,
+            "box" => p.kkt.1,
+            "bag" => p.kkt.2,
+            _ => p.kkt.3,
+        };
         for rep in 0..reps {
             let o = PairOpts {
                 frames: frames_for(dur, setup.fps),
@@ -1323,6 +1319,7 @@ fn run_table55(ctx: &RunCtx) -> Result<Summary> {
             }
         }
         let b = best.expect("at least one repetition");
+        main_runs.push((kkt, 1e3 * b.t_untracked / b.steps.max(1) as f64));
         let n = setup.tracked_rest.n_vertices();
         s.set(&format!("overhead_pct_{name}"), b.overhead_pct());
         s.set(&format!("s_per_frame_tracked_{name}"), b.s_per_frame_tracked());
@@ -1361,6 +1358,9 @@ fn run_table55(ctx: &RunCtx) -> Result<Summary> {
     s.set_count("repeats", reps as u64);
     s.set_count("threads", rayon::current_num_threads() as u64);
     s.set_str("kkt", &format!("{:?}", p.kkt));
+    if !p.compare.is_empty() {
+        compare_methods(ctx, &p, &scenes, &main_runs, &mut s, &mut report)?;
+    }
     s.set_str("mode", m.name());
     report.push_str(&format!(
         "\nMode {}, {dur} s per scene, best of {reps}, self-collision {sc}, {} threads, profile as built.\n",
@@ -1370,4 +1370,83 @@ fn run_table55(ctx: &RunCtx) -> Result<Summary> {
     std::fs::write(ctx.out_dir.join("report.md"), report)
         .map_err(crate::error::io_err(ctx.out_dir.join("report.md")))?;
     Ok(s)
+}
+
+/// The spec §6.9 shadow-timed run, extended: per scene one tracked run whose every system is also
+/// solved by each method of `p.compare` and by an unused LLᵀ of A (the untracked factorisation),
+/// all timed on identical matrices; writes `kkt_methods.csv` and a report section.
+fn compare_methods(
+    ctx: &RunCtx,
+    p: &TableParams,
+    scenes: &[(&str, Setup, f64, [f64; 3])],
+    main_runs: &[(KktMethod, f64)],
+    s: &mut Summary,
+    report: &mut String,
+) -> Result<()> {
+    let dur = pick3(ctx.mode, p.compare_duration);
+    let mut csv = CsvWriter::create(
+        &ctx.out_dir.join("kkt_methods.csv"),
+        &["scene", "method", "ms_per_step", "ms_llt_of_a_per_step", "solve_overhead_pct", "max_rel_diff", "nnz_l"],
+    )?;
+    report.push_str(&format!(
+        "\n## KKT methods on identical systems ({dur} s per scene, ms per step; LLᵀ of A = the untracked factorisation)\n\n| scene | LLᵀ of A | {} |\n|---|---|{}\n",
+        p.compare.iter().map(|m| format!("{m:?}")).collect::<Vec<_>>().join(" | "),
+        "---|".repeat(p.compare.len())
+    ));
+    for ((name, setup, _, _), (main_kkt, untracked_ms)) in scenes.iter().zip(main_runs) {
+        let o = PairOpts {
+            frames: frames_for(dur, setup.fps),
+            obj_every: 0,
+            untracked: false,
+            track: TrackOptions {
+                kkt: p.compare[0],
+                refine_steps: p.refine_steps,
+                shadow_timing: true,
+                compare: p.compare.clone(),
+                ..TrackOptions::default()
+            },
+            intersections: false,
+            anchors: None,
+            tag: format!("_{name}_methods"),
+        };
+        let out = run_pair(setup, &o, &ctx.out_dir)?;
+        let steps = out.steps.max(1) as f64;
+        let llt_ms = 1e3 * out.t_shadow / steps;
+        let mut cells = Vec::new();
+        for (m, c) in p.compare.iter().zip(&out.compare) {
+            let ms = 1e3 * c.0 / steps;
+            csv.row(&[
+                Cell::Text(name.to_string()),
+                Cell::Text(format!("{m:?}")),
+                Cell::Num(ms),
+                Cell::Num(llt_ms),
+                Cell::Num(100.0 * (ms - llt_ms) / llt_ms.max(1e-300)),
+                Cell::Num(c.1),
+                Cell::Int(c.2 as i64),
+            ])?;
+            s.set(&format!("kkt_ms_{name}_{}", method_key(m)), ms);
+            cells.push(format!("{ms:.2}"));
+        }
+        s.set(&format!("llt_ms_{name}"), llt_ms);
+        // Spec §3.8 solve overhead of the scene's method: (t_kkt − t_LLᵀ(A)) / untracked step,
+        // both solves timed on the same matrices in this run.
+        if let Some(c) = p.compare.iter().position(|m| m == main_kkt).map(|i| out.compare[i]) {
+            s.set(&format!("solve_overhead_pct_{name}"), 100.0 * (1e3 * c.0 / steps - llt_ms) / untracked_ms);
+        }
+        report.push_str(&format!("| {name} | {llt_ms:.2} | {} |\n", cells.join(" | ")));
+    }
+    Ok(())
+}
+
+/// Short snake-case key of a KKT method for summary keys.
+fn method_key(m: &KktMethod) -> &'static str {
+    match m {
+        KktMethod::ConstraintLastLdlt => "constraint_last",
+        KktMethod::InterleavedLdlt => "interleaved",
+        KktMethod::AmdRegularizedLdlt { .. } => "amd_regularized",
+        KktMethod::Schur => "schur",
+        KktMethod::SchurPcg { .. } => "schur_pcg",
+        KktMethod::Penalty { .. } => "penalty",
+        KktMethod::Compliant { .. } => "compliant",
+    }
 }

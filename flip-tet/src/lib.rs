@@ -1,0 +1,19 @@
+//! Highly adaptive FLIP liquids on graded tetrahedral (BCC) meshes, after Ando, Thürey and Wojtan,
+//! *Highly Adaptive Liquid Simulations on Tetrahedral Meshes*, SIGGRAPH 2013.
+//!
+//! See `README.md` and `shared/specs/flip-tet.md` for the method and the module map (spec §2).
+
+pub mod bcc;
+pub mod error;
+#[cfg(feature = "fvm-baseline")]
+pub mod fvm_baseline;
+pub mod metrics;
+pub mod octree;
+pub mod ops;
+pub mod particles;
+pub mod pressure;
+pub mod scene;
+pub mod sim;
+pub mod sizing;
+pub mod surface;
+pub mod transfer;

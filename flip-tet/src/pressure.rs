@@ -1,0 +1,450 @@
+//! Pressure projection on the tet mesh (spec §3.4–3.6): liquid classification, second-order
+//! ghost-fluid embedding with the symmetric θ choice and the per-tet `k_t` blend to first order,
+//! assembly of the SPD system `A q = b`, solve (direct or PCG through geom-core), and the velocity
+//! update `u ← u* − G̃ q` with the same ghost values.
+//!
+//! `q = Δt p / ρ` (m²/s). Nodes with `φ < 0` are liquid DOFs (`|φ| ≤ 1e−9 h_min` is snapped to
+//! air first); air nodes carry ghost values per tet.
+
+use geom_core::linalg::{pcg, CgOptions, Csr, Ic0, Jacobi, LltSymbolic, Ordering, SparseLlt, Triplets};
+use geom_core::math::Vec3;
+use geom_core::NONE;
+use serde::{Deserialize, Serialize};
+
+use crate::bcc::TetMesh;
+use crate::error::{Result, SimError, SolverKind};
+use crate::ops::{fluid_fraction, local_stiffness};
+
+/// Pressure parameters (scene `pressure: (...)`, spec §4).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PressureParams {
+    /// Second-order ghost-fluid free surface (else `p = 0` at air nodes).
+    pub second_order: bool,
+    /// Diagonal-dominance tolerance τ of the `k_t` rule (paper: 0.25).
+    pub ghost_tolerance: f64,
+    /// Clamp `λ_min` of the interface fraction along the extrapolation line.
+    pub min_interface_fraction: f64,
+    /// Solver choice.
+    pub solver: SolverKind,
+    /// Relative residual tolerance of PCG.
+    pub tol: f64,
+    /// PCG iteration cap.
+    pub max_iters: usize,
+    /// `Auto` uses the direct solver up to this many DOFs.
+    pub direct_max_dofs: usize,
+    /// MIC(0) modification factor.
+    pub mic_factor: f64,
+}
+
+impl Default for PressureParams {
+    fn default() -> Self {
+        Self {
+            second_order: true,
+            ghost_tolerance: 0.25,
+            min_interface_fraction: 0.01,
+            solver: SolverKind::Auto,
+            tol: 1e-6,
+            max_iters: 2000,
+            direct_max_dofs: 30_000,
+            mic_factor: 0.97,
+        }
+    }
+}
+
+/// Tets with a fluid fraction below this are dropped from the assembly (spec §3.4 `w_min`).
+pub const W_MIN: f64 = 0.01;
+
+/// One ghost value of an interface tet (spec §3.5): `q̂_g = scale · Σ_l θ_l q_l`, where `scale`
+/// already includes `k_t` and `s_g` (0 for a first-order fallback).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ghost {
+    /// Tet.
+    pub tet: u32,
+    /// Local index (0..4) of the air vertex.
+    pub local: u8,
+    /// `k_t s_g` (0 for first order).
+    pub scale: f64,
+    /// θ per local vertex (0 for air vertices).
+    pub theta: [f64; 4],
+}
+
+/// The assembled system (spec §2 `PressureSystem`).
+#[derive(Clone, Debug, Default)]
+pub struct PressureSystem {
+    /// DOF index of each node, `NONE` for air/solid nodes.
+    pub dof_of_node: Vec<u32>,
+    /// Node of each DOF.
+    pub node_of_dof: Vec<u32>,
+    /// Symmetric system matrix over the DOFs.
+    pub matrix: Csr,
+    /// Right-hand side `b = D u*` on the DOFs.
+    pub rhs: Vec<f64>,
+    /// Ghost records (per air vertex of each interface tet).
+    pub ghosts: Vec<Ghost>,
+    /// Offsets of each tet's ghosts in `ghosts` (len m + 1).
+    pub ghost_start: Vec<u32>,
+    /// Number of interface tets (with at least one liquid and one air vertex).
+    pub n_ghost_tets: usize,
+    /// Number of interface tets with `k_t < 1` (including first-order fallbacks).
+    pub n_k_reduced: usize,
+    /// DOFs pinned to 0 (closed liquid components, spec §3.6 null space).
+    pub pinned: Vec<u32>,
+}
+
+/// Solver outcome (spec §2 `SolveReport`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SolveReport {
+    /// Solver used last.
+    pub kind: SolverKind,
+    /// PCG iterations (0 for direct).
+    pub iters: usize,
+    /// Relative residual `‖b − A q‖ / ‖b‖`.
+    pub rel_residual: f64,
+    /// Non-zeros of the Cholesky factor (0 for PCG).
+    pub factor_nnz: usize,
+}
+
+/// Liquid classification (spec §3.4): `φ_i < 0` after snapping `|φ| ≤ 1e−9 h_min` to 0, and not
+/// a solid node (all incident tets below `W_MIN`).
+pub fn liquid_nodes(mesh: &TetMesh, phi: &[f64], h_min: f64) -> Vec<bool> {
+    (0..mesh.nodes.len())
+        .map(|i| {
+            let p = if phi[i].abs() <= 1e-9 * h_min { 0.0 } else { phi[i] };
+            let solid =
+                mesh.solid_frac.as_ref().is_some_and(|w| mesh.node_tets.row(i).iter().all(|&t| w[t as usize] < W_MIN));
+            p < 0.0 && !solid
+        })
+        .collect()
+}
+
+/// Ghost-induced loss of diagonal dominance of local row `i` at blend `k` (spec §3.5).
+fn loss(kt: &[[f64; 4]; 4], delta: &[[f64; 4]; 4], liq: &[bool; 4], i: usize, k: f64) -> f64 {
+    let mut s = -k * delta[i][i];
+    for l in 0..4 {
+        if l != i && liq[l] {
+            s += (kt[i][l] + k * delta[i][l]).abs() - kt[i][l].abs();
+        }
+    }
+    s
+}
+
+/// Assembles the pressure system for the intermediate velocity `u_star` (per tet) and node level
+/// set `phi` (spec §3.4–3.6).
+pub fn assemble_pressure(
+    mesh: &TetMesh,
+    phi: &[f64],
+    u_star: &[Vec3],
+    h_min: f64,
+    p: &PressureParams,
+) -> PressureSystem {
+    let n = mesh.nodes.len();
+    let liquid = liquid_nodes(mesh, phi, h_min);
+    let phi_s: Vec<f64> = phi.iter().map(|&v| if v.abs() <= 1e-9 * h_min { 0.0 } else { v }).collect();
+    let mut dof_of_node = vec![NONE; n];
+    let mut node_of_dof = Vec::new();
+    for i in 0..n {
+        if liquid[i] {
+            dof_of_node[i] = node_of_dof.len() as u32;
+            node_of_dof.push(i as u32);
+        }
+    }
+    let nd = node_of_dof.len();
+    // Global diagonal without ghost terms (first pass).
+    let mut diag = vec![0.0; nd];
+    let mut rhs = vec![0.0; nd];
+    let mut has_air = vec![false; nd];
+    let m = mesh.tets.len();
+    let mut tr = Triplets::with_capacity(nd, nd, m * 8);
+    let mut keep = vec![false; m];
+    for (t, tv) in mesh.tets.iter().enumerate() {
+        let w = fluid_fraction(mesh, t);
+        if w < W_MIN || !tv.iter().any(|&i| liquid[i as usize]) {
+            continue;
+        }
+        keep[t] = true;
+        let g = &mesh.grad_bary[t];
+        for a in 0..4 {
+            let d = dof_of_node[tv[a] as usize];
+            if d != NONE {
+                diag[d as usize] += mesh.volume[t] * w * g[a].norm_squared();
+                rhs[d as usize] += mesh.volume[t] * w * g[a].dot(&u_star[t]);
+            }
+        }
+    }
+    let mut ghosts = Vec::new();
+    let mut ghost_start = Vec::with_capacity(m + 1);
+    let (mut n_ghost_tets, mut n_k_reduced) = (0usize, 0usize);
+    for (t, tv) in mesh.tets.iter().enumerate() {
+        ghost_start.push(ghosts.len() as u32);
+        if !keep[t] {
+            continue;
+        }
+        let kt = local_stiffness(mesh, t);
+        let liq: [bool; 4] = tv.map(|i| liquid[i as usize]);
+        let d: [u32; 4] = tv.map(|i| dof_of_node[i as usize]);
+        for i in 0..4 {
+            if !liq[i] {
+                continue;
+            }
+            for j in 0..4 {
+                if liq[j] {
+                    tr.push(d[i], d[j], kt[i][j]);
+                } else if kt[i][j].abs() > 1e-12 * kt[i][i] {
+                    has_air[d[i] as usize] = true;
+                }
+            }
+        }
+        if liq.iter().all(|&b| b) {
+            continue;
+        }
+        n_ghost_tets += 1;
+        if !p.second_order {
+            continue;
+        }
+        let h_t = mesh.volume[t].cbrt();
+        let mut delta = [[0.0; 4]; 4];
+        let mut local_ghosts: Vec<(u8, f64, [f64; 4], bool)> = Vec::new();
+        let mut first_order = false;
+        let nl = liq.iter().filter(|&&b| b).count() as f64;
+        for gi in 0..4 {
+            if liq[gi] {
+                continue;
+            }
+            let mut c = [0.0; 4];
+            for l in 0..4 {
+                if liq[l] && kt[l][gi].abs() >= 1e-10 * kt[gi][gi].abs() {
+                    c[l] = kt[l][gi];
+                }
+            }
+            let csum: f64 = c.iter().sum();
+            let coupled = c.iter().any(|&v| v != 0.0);
+            let theta: [f64; 4] = if !coupled {
+                std::array::from_fn(|l| if liq[l] { 1.0 / nl } else { 0.0 })
+            } else if csum > -1e-10 * kt[gi][gi].abs() {
+                // Mixed-sign couplings: θ undefined, first-order fallback for this ghost.
+                first_order = true;
+                local_ghosts.push((gi as u8, 0.0, [0.0; 4], false));
+                continue;
+            } else {
+                std::array::from_fn(|l| c[l] / csum)
+            };
+            let phit: f64 = (0..4).map(|l| theta[l] * phi_s[tv[l] as usize]).sum();
+            if phit >= -1e-12 * h_t {
+                first_order = true;
+                local_ghosts.push((gi as u8, 0.0, [0.0; 4], false));
+                continue;
+            }
+            let phig = phi_s[tv[gi] as usize];
+            let lam = (phit / (phit - phig)).max(p.min_interface_fraction);
+            let s = -(1.0 - lam) / lam;
+            if coupled {
+                for i in 0..4 {
+                    for j in 0..4 {
+                        delta[i][j] += s / csum * c[i] * c[j];
+                    }
+                }
+            }
+            local_ghosts.push((gi as u8, s, theta, coupled));
+        }
+        let mut k = if first_order { 0.0 } else { 1.0 };
+        if k > 0.0 {
+            let ok = |k: f64| {
+                (0..4)
+                    .filter(|&i| liq[i])
+                    .all(|i| loss(&kt, &delta, &liq, i, k) <= p.ghost_tolerance * diag[d[i] as usize])
+            };
+            if !ok(1.0) {
+                let (mut lo, mut hi) = (0.0, 1.0);
+                for _ in 0..30 {
+                    let mid = 0.5 * (lo + hi);
+                    if ok(mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                k = lo;
+            }
+        }
+        if k < 1.0 {
+            n_k_reduced += 1;
+        }
+        if k > 0.0 {
+            for i in 0..4 {
+                for j in 0..4 {
+                    if liq[i] && liq[j] && delta[i][j] != 0.0 {
+                        tr.push(d[i], d[j], k * delta[i][j]);
+                    }
+                }
+            }
+        }
+        for (gi, s, theta, _) in local_ghosts {
+            ghosts.push(Ghost { tet: t as u32, local: gi, scale: k * s, theta });
+        }
+    }
+    ghost_start.push(ghosts.len() as u32);
+    let mut matrix = Csr::from_triplets(&tr);
+    // Null space (spec §3.6): pin the lowest DOF of every component without air coupling.
+    let mut pinned = Vec::new();
+    if nd > 0 {
+        let (nc, label) = matrix.pattern_components();
+        let mut comp_air = vec![false; nc];
+        let mut lowest = vec![u32::MAX; nc];
+        for dd in 0..nd {
+            let c = label[dd] as usize;
+            comp_air[c] |= has_air[dd];
+            lowest[c] = lowest[c].min(dd as u32);
+        }
+        for c in 0..nc {
+            if !comp_air[c] {
+                pinned.push(lowest[c]);
+            }
+        }
+        for &pd in &pinned {
+            for r in 0..nd {
+                let (s, e) = (matrix.row_ptr[r], matrix.row_ptr[r + 1]);
+                for k in s..e {
+                    let cidx = matrix.col[k];
+                    if r as u32 == pd || cidx == pd {
+                        matrix.val[k] = if r as u32 == cidx { 1.0 } else { 0.0 };
+                    }
+                }
+            }
+            rhs[pd as usize] = 0.0;
+        }
+    }
+    PressureSystem { dof_of_node, node_of_dof, matrix, rhs, ghosts, ghost_start, n_ghost_tets, n_k_reduced, pinned }
+}
+
+/// Reusable solver state: the symbolic Cholesky analysis is kept while the pattern is unchanged.
+#[derive(Default)]
+pub struct PressureSolver {
+    cached: Option<(Vec<usize>, Vec<u32>, LltSymbolic)>,
+    /// Number of symbolic analyses performed (diagnostics).
+    pub n_analyses: usize,
+}
+
+impl PressureSolver {
+    fn direct(&mut self, a: &Csr, b: &[f64]) -> Result<(Vec<f64>, SolveReport)> {
+        let csc = a.to_csc_lower();
+        let reuse = matches!(&self.cached, Some((rp, c, _)) if *rp == a.row_ptr && *c == a.col);
+        if !reuse {
+            let sym = LltSymbolic::analyze(&csc, &Ordering::Amd)?;
+            self.cached = Some((a.row_ptr.clone(), a.col.clone(), sym));
+            self.n_analyses += 1;
+        }
+        // Invariant: `cached` was set just above when it did not match.
+        let sym = &self.cached.as_ref().expect("symbolic analysis cached").2;
+        let mut llt = SparseLlt::from_symbolic(sym);
+        llt.factor(&csc)?;
+        let mut x = b.to_vec();
+        llt.solve_in_place(&mut x)?;
+        let rel = rel_res(a, &x, b);
+        Ok((x, SolveReport { kind: SolverKind::DirectCholesky, iters: 0, rel_residual: rel, factor_nnz: llt.nnz_l() }))
+    }
+
+    /// Solves `A q = b` (spec §3.6) with the chosen solver; `warm` is the PCG start.
+    pub fn solve(
+        &mut self,
+        sys: &PressureSystem,
+        p: &PressureParams,
+        warm: Option<&[f64]>,
+    ) -> Result<(Vec<f64>, SolveReport)> {
+        let nd = sys.rhs.len();
+        if nd == 0 {
+            return Ok((Vec::new(), SolveReport { kind: SolverKind::None, ..Default::default() }));
+        }
+        let kind = match p.solver {
+            SolverKind::Auto | SolverKind::None => {
+                if nd <= p.direct_max_dofs {
+                    SolverKind::DirectCholesky
+                } else {
+                    SolverKind::PcgIc0
+                }
+            }
+            k => k,
+        };
+        let a = &sys.matrix;
+        let b = &sys.rhs;
+        let cg = |pre: &dyn geom_core::linalg::Preconditioner, kind: SolverKind| -> Result<(Vec<f64>, SolveReport)> {
+            let mut x = match warm {
+                Some(w) if w.len() == nd => w.to_vec(),
+                _ => vec![0.0; nd],
+            };
+            let o = CgOptions { tol: p.tol, max_iters: p.max_iters, history: false };
+            let r = pcg(a, b, &mut x, pre, &o)?;
+            if !r.converged {
+                return Err(SimError::SolverFailed { kind, iters: r.iters, residual: r.rel_residual });
+            }
+            Ok((x, SolveReport { kind, iters: r.iters, rel_residual: r.rel_residual, factor_nnz: 0 }))
+        };
+        match kind {
+            SolverKind::DirectCholesky => self.direct(a, b),
+            SolverKind::PcgJacobi => cg(&Jacobi::new(a)?, SolverKind::PcgJacobi),
+            _ => {
+                let res =
+                    Ic0::new(a, Some(p.mic_factor)).map_err(SimError::from).and_then(|ic| cg(&ic, SolverKind::PcgIc0));
+                match res {
+                    Ok(v) => Ok(v),
+                    Err(e) if p.solver == SolverKind::Auto => {
+                        // MIC breakdown or no convergence: Jacobi fallback (spec §3.6 Auto).
+                        let _ = e;
+                        cg(&Jacobi::new(a)?, SolverKind::PcgJacobi)
+                    }
+                    Err(e) => Err(e),
+                }
+            }
+        }
+    }
+}
+
+fn rel_res(a: &Csr, x: &[f64], b: &[f64]) -> f64 {
+    let mut y = vec![0.0; b.len()];
+    a.mul_vec(x, &mut y);
+    let num: f64 = y.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>().sqrt();
+    let den: f64 = b.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if den > 0.0 {
+        num / den
+    } else {
+        num
+    }
+}
+
+/// Nodal pressure values `q̂` seen by tet `t` (liquid DOF values, ghost values at air vertices,
+/// spec §3.4–3.5).
+pub fn tet_pressures(mesh: &TetMesh, sys: &PressureSystem, q: &[f64], t: usize) -> [f64; 4] {
+    let tv = mesh.tets[t];
+    let mut out = [0.0; 4];
+    for a in 0..4 {
+        let d = sys.dof_of_node[tv[a] as usize];
+        if d != NONE {
+            out[a] = q[d as usize];
+        }
+    }
+    let liq = out;
+    for g in &sys.ghosts[sys.ghost_start[t] as usize..sys.ghost_start[t + 1] as usize] {
+        let s: f64 = (0..4).map(|l| g.theta[l] * liq[l]).sum();
+        out[g.local as usize] = g.scale * s;
+    }
+    out
+}
+
+/// Velocity update `u_t ← u*_t − Σ_a q̂_a ∇λ_a` on every tet with a liquid node (spec §3.4);
+/// returns the mask of updated tets.
+pub fn apply_pressure(mesh: &TetMesh, sys: &PressureSystem, q: &[f64], u: &mut [Vec3]) -> Vec<bool> {
+    let mut upd = vec![false; mesh.tets.len()];
+    for t in 0..mesh.tets.len() {
+        if !mesh.tets[t].iter().any(|&i| sys.dof_of_node[i as usize] != NONE) {
+            continue;
+        }
+        if mesh.solid_frac.as_ref().is_some_and(|w| w[t] < W_MIN) {
+            continue;
+        }
+        let qh = tet_pressures(mesh, sys, q, t);
+        let g = &mesh.grad_bary[t];
+        u[t] -= g[0] * qh[0] + g[1] * qh[1] + g[2] * qh[2] + g[3] * qh[3];
+        upd[t] = true;
+    }
+    upd
+}

@@ -1,0 +1,928 @@
+//! [`FlipTetSim`]: the adaptive FLIP time loop of spec §3.1 on the graded BCC mesh, with
+//! CFL time-step control (§3.13), remeshing with split/merge (§3.2, §3.10), per-stage timings and
+//! step statistics.
+
+use std::time::Instant;
+
+use geom_core::math::{Pt3, Vec3};
+use geom_core::mesh::TriMesh;
+use geom_core::rng::Rng;
+use geom_core::spatial::KdTree;
+use geom_core::NONE;
+use rayon::prelude::*;
+
+use crate::bcc::{tetrahedralize, TetMesh};
+use crate::error::{Result, SimError};
+use crate::octree::{balance_2to1, build_octree, Octree, OctreeSpec, SizeDemand};
+use crate::particles::{
+    apply_obstacles, apply_walls, classify_ballistic, position_correction, ParticleFlags, Particles,
+};
+use crate::pressure::{apply_pressure, assemble_pressure, PressureSolver, SolveReport, W_MIN};
+use crate::scene::{BoxFace, DtPolicy, Scene, Shape};
+use crate::sizing::{Sizing, SizingContext, SurfaceCurvature, C_H};
+use crate::surface::{level_set_on_nodes, liquid_volume, tet_liquid_volume, Walls};
+use crate::transfer::{blend_weak, extrapolate, node_average, particles_to_tets, pic_fraction, sample};
+
+/// Liquid density used for the energies (kg/m³).
+pub const RHO: f64 = 1000.0;
+
+/// Seconds spent per phase of one step (spec §3.1 list).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PhaseTimings {
+    /// Ballistic classification and neighbour tree.
+    pub ballistic: f64,
+    /// Level set on nodes (simulation surface).
+    pub levelset: f64,
+    /// Sizing, octree, tetrahedralisation, split/merge (remesh steps only).
+    pub remesh: f64,
+    /// P2G.
+    pub p2g: f64,
+    /// Extrapolations and nodal averages.
+    pub extrapolate: f64,
+    /// Pressure assembly.
+    pub assemble: f64,
+    /// Linear solve.
+    pub solve: f64,
+    /// Velocity update.
+    pub apply: f64,
+    /// G2P.
+    pub g2p: f64,
+    /// Advection, walls, obstacles.
+    pub advect: f64,
+    /// Position correction.
+    pub correction: f64,
+}
+
+impl PhaseTimings {
+    /// The five stages: (remesh, transfer, solve, advect, surface) in seconds.
+    pub fn stages(&self) -> [f64; 5] {
+        [
+            self.remesh,
+            self.p2g + self.extrapolate + self.g2p,
+            self.assemble + self.solve + self.apply,
+            self.advect + self.correction + self.ballistic,
+            self.levelset,
+        ]
+    }
+
+    /// Total seconds.
+    pub fn total(&self) -> f64 {
+        self.stages().iter().sum()
+    }
+}
+
+/// Statistics of one step (spec §2).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct StepStats {
+    /// Step counter (0-based, before increment).
+    pub step: u64,
+    /// Time at the end of the step (s).
+    pub t: f64,
+    /// Step size (s).
+    pub dt: f64,
+    /// Whether the mesh was rebuilt in this step.
+    pub remeshed: bool,
+    /// Whether the step ended on a frame boundary.
+    pub frame_end: bool,
+    /// Particles.
+    pub n_particles: usize,
+    /// Ballistic particles.
+    pub n_ballistic: usize,
+    /// Splits at this step's remesh.
+    pub n_split: usize,
+    /// Merges at this step's remesh.
+    pub n_merge: usize,
+    /// Particles deleted at open faces.
+    pub n_deleted: usize,
+    /// Mesh nodes.
+    pub n_nodes: usize,
+    /// Mesh tets.
+    pub n_tets: usize,
+    /// Pressure DOFs.
+    pub n_dofs: usize,
+    /// Interface tets.
+    pub n_ghost_tets: usize,
+    /// Interface tets with `k_t < 1`.
+    pub n_k_reduced: usize,
+    /// Solver report.
+    pub solver: SolveReport,
+    /// `Σ (2r)³` (m³).
+    pub vol_particles: f64,
+    /// Liquid volume of the node level set (m³).
+    pub vol_levelset: f64,
+    /// Kinetic energy (J, ρ = 1000).
+    pub kinetic_energy: f64,
+    /// Potential energy `Σ ρ V (−g·x)` (J).
+    pub potential_energy: f64,
+    /// Largest particle speed (m/s).
+    pub max_speed: f64,
+    /// Advection substeps beyond one (sum over particles).
+    pub cfl_substeps: u32,
+    /// Per-phase seconds.
+    pub timings: PhaseTimings,
+}
+
+/// The simulator (spec §2).
+pub struct FlipTetSim {
+    scene: Scene,
+    spec: OctreeSpec,
+    sizing: Sizing,
+    octree: Octree,
+    mesh: TetMesh,
+    h_tet: Vec<f64>,
+    edges: geom_core::graph::Ragged<u32>,
+    parts: Particles,
+    phi: Vec<f64>,
+    nodal_u: Vec<Vec3>,
+    solver: PressureSolver,
+    warm: Option<(Vec<u32>, Vec<f64>)>,
+    step: u64,
+    time: f64,
+    frame: u64,
+    rng: Rng,
+    open: [bool; 6],
+    /// Largest initial liquid height above the domain floor (m), for `U_ref` of the turbulence metric.
+    h_ref: f64,
+    /// Volume of deleted particles (m³).
+    pub deleted_volume: f64,
+    /// Particle budget hit at the last remesh.
+    pub budget_hit: bool,
+}
+
+fn face_index(f: BoxFace) -> usize {
+    match f {
+        BoxFace::NegX => 0,
+        BoxFace::PosX => 1,
+        BoxFace::NegY => 2,
+        BoxFace::PosY => 3,
+        BoxFace::NegZ => 4,
+        BoxFace::PosZ => 5,
+    }
+}
+
+/// Samples every leaf inside the liquid with 2×2×2 particles of radius `h_leaf/4` at the sub-cube
+/// centres (spec S1a), jittered by `jitter · 2r`; optional standing-wave column stretching.
+fn sample_particles(scene: &Scene, oct: &Octree, rng: &mut Rng) -> Particles {
+    let mut p = Particles::default();
+    let jit = scene.particles.sampling_jitter;
+    for lf in &oct.leaves {
+        let h = oct.spec.h(lf.level);
+        let o = oct.spec.position(&lf.origin.0);
+        let r = h / 4.0;
+        for c in 0..8 {
+            let mut x = o + Vec3::new(
+                (0.5 + (c & 1) as f64) * h / 2.0,
+                (0.5 + ((c >> 1) & 1) as f64) * h / 2.0,
+                (0.5 + ((c >> 2) & 1) as f64) * h / 2.0,
+            );
+            if jit > 0.0 {
+                x += Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * (jit * r);
+            }
+            let d = scene.liquid_sdf(&x);
+            if d < 0.0 && scene.solid_sdf(&x) > r {
+                p.push(x, scene.velocity_at(&x), r, scene.initial_phi(&x));
+            }
+        }
+    }
+    if scene.particles.column_top_on_surface {
+        if let Some(Shape::CosineSurface { mean, amplitude, length, x0 }) = scene.liquid.first() {
+            // Column = same (x, z); stretch each column evenly so that its top particle sits at
+            // η(x) − r and its bottom particle stays where it is (spec S3 column sampling).
+            let mut cols: std::collections::HashMap<(i64, i64), Vec<usize>> = std::collections::HashMap::new();
+            let q = oct.spec.unit() * 1e-3;
+            for i in 0..p.len() {
+                let key = ((p.x[i].x / q).round() as i64, (p.x[i].z / q).round() as i64);
+                cols.entry(key).or_default().push(i);
+            }
+            let mut keys: Vec<(i64, i64)> = cols.keys().copied().collect();
+            keys.sort_unstable();
+            for key in keys {
+                let ids = &cols[&key];
+                let (mut lo, mut hi) = (ids[0], ids[0]);
+                for &i in ids {
+                    if p.x[i].y < p.x[lo].y {
+                        lo = i;
+                    }
+                    if p.x[i].y > p.x[hi].y {
+                        hi = i;
+                    }
+                }
+                let eta = mean + amplitude * (std::f64::consts::PI * (p.x[hi].x - x0) / length).cos();
+                let (y0, y1) = (p.x[lo].y, p.x[hi].y);
+                let target = eta - p.r[hi];
+                for &i in ids {
+                    if y1 > y0 {
+                        p.x[i].y = y0 + (p.x[i].y - y0) * (target - y0) / (y1 - y0);
+                    } else {
+                        p.x[i].y = target;
+                    }
+                    p.phi[i] = p.x[i].y - eta;
+                }
+            }
+        }
+    }
+    p
+}
+
+/// One-layer redistancing of the liquid side from the exact outside values (ours, see README
+/// "Deviations"): for every liquid node `i` with an edge to a node `g` with `φ_g ≥ 0`,
+/// `φ_i ← min(φ_i, max_g (φ_g − |x_i − x_g|))`.
+///
+/// Why: inside a union of hulls the minimum of the component distances only bounds the true
+/// signed distance from above (it is too shallow, e.g. −0.52 r instead of −2 r one half cube
+/// below a flat particle surface), while the 1-Lipschitz bound `φ_g − |x_i − x_g|` from the exact
+/// outside values bounds it from below and is exact whenever a neighbour lies along the surface
+/// normal (every flat horizontal surface on the BCC lattice). The ghost-fluid fractions
+/// `s_g = φ_g / φ̃` of §3.5 need the liquid-side values, so without this the resting pool is not an
+/// equilibrium.
+pub fn redistance_first_layer(nodes: &[Pt3], edges: &geom_core::graph::Ragged<u32>, phi: &mut [f64]) {
+    let upd: Vec<Option<f64>> = (0..phi.len())
+        .into_par_iter()
+        .map(|i| {
+            if phi[i] >= 0.0 {
+                return None;
+            }
+            let mut best = f64::NEG_INFINITY;
+            for &g in edges.row(i) {
+                let g = g as usize;
+                if phi[g] >= 0.0 {
+                    best = best.max(phi[g] - (nodes[i] - nodes[g]).norm());
+                }
+            }
+            (best > f64::NEG_INFINITY && best < phi[i]).then_some(best)
+        })
+        .collect();
+    for (i, u) in upd.into_iter().enumerate() {
+        if let Some(v) = u {
+            phi[i] = v;
+        }
+    }
+}
+
+impl FlipTetSim {
+    /// Builds the simulator: validates the scene, finds the initial octree as a fixed point of
+    /// "octree → lattice particles → particle demands → octree" (spec S1a), samples particles
+    /// and builds the mesh.
+    pub fn new(scene: &Scene) -> Result<Self> {
+        scene.validate()?;
+        let spec = OctreeSpec::new(scene.min(), scene.max(), scene.resolution.coarsest, scene.resolution.finest)?;
+        let sizing = Sizing::from_params(&scene.sizing).map_err(|e| SimError::InvalidScene(e.to_string()))?;
+        let mut rng = Rng::new(scene.seed);
+        let mut open = [false; 6];
+        for f in &scene.open_faces {
+            open[face_index(*f)] = true;
+        }
+        let mut octree = Octree::uniform(spec, 0);
+        let mut parts = sample_particles(scene, &octree, &mut rng.clone());
+        if spec.levels > 1 {
+            for _ in 0..12 {
+                // Curvature sizing needs a surface at t = 0: the analytic liquid SDF on the current mesh.
+                let curv = if sizing.needs_surface() {
+                    tetrahedralize(&octree).ok().and_then(|m| {
+                        let phi: Vec<f64> = m.nodes.iter().map(|x| scene.liquid_sdf(x)).collect();
+                        let tri = crate::surface::marching_tets(&m, &phi).ok()?;
+                        if tri.faces.is_empty() {
+                            return None;
+                        }
+                        let sm = crate::surface::smooth_surface(&tri, scene.surface.smoothing_iterations);
+                        let k = crate::surface::vertex_curvature(&sm, 1.0 / (2.0 * spec.h_min() / C_H));
+                        Some(SurfaceCurvature::new(&sm, k))
+                    })
+                } else {
+                    None
+                };
+                let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
+                ctx.surface = curv.as_ref();
+                let demands = Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx));
+                let mut next = build_octree(spec, &demands);
+                if scene.extra_grading_layers > 0 {
+                    balance_2to1(&mut next, scene.extra_grading_layers);
+                }
+                let same = next.leaves == octree.leaves;
+                octree = next;
+                parts = sample_particles(scene, &octree, &mut rng.clone());
+                if same {
+                    break;
+                }
+            }
+        }
+        let _ = rng.next_u64();
+        let h_ref = parts.x.iter().zip(&parts.r).map(|(x, r)| x.y + r - scene.domain.min[1]).fold(0.0, f64::max);
+        let mut sim = Self {
+            scene: scene.clone(),
+            spec,
+            sizing,
+            octree: octree.clone(),
+            mesh: TetMesh::default(),
+            h_tet: Vec::new(),
+            edges: geom_core::graph::Ragged::new(),
+            parts,
+            phi: Vec::new(),
+            nodal_u: Vec::new(),
+            solver: PressureSolver::default(),
+            warm: None,
+            step: 0,
+            time: 0.0,
+            frame: 0,
+            rng,
+            open,
+            h_ref,
+            deleted_volume: 0.0,
+            budget_hit: false,
+        };
+        sim.set_mesh(octree)?;
+        sim.relocate();
+        sim.phi = sim.level_set();
+        Ok(sim)
+    }
+
+    fn set_mesh(&mut self, oct: Octree) -> Result<()> {
+        let mut mesh = tetrahedralize(&oct)?;
+        if !self.scene.obstacles.is_empty() {
+            let sdf: Vec<f64> = mesh.nodes.par_iter().map(|x| self.scene.solid_sdf(x)).collect();
+            let w: Vec<f64> = (0..mesh.tets.len())
+                .into_par_iter()
+                .map(|t| {
+                    let tv = mesh.tets[t];
+                    let p = tv.map(|i| mesh.nodes[i as usize]);
+                    let v = tv.map(|i| -sdf[i as usize]);
+                    (tet_liquid_volume(&p, &v) / mesh.volume[t]).clamp(0.0, 1.0)
+                })
+                .collect();
+            mesh.solid_frac = Some(w);
+        }
+        self.h_tet = mesh.tet_level.iter().map(|&l| self.spec.h(l)).collect();
+        self.nodal_u = vec![Vec3::zeros(); mesh.nodes.len()];
+        self.edges = crate::surface::node_edges(&mesh);
+        self.mesh = mesh;
+        self.octree = oct;
+        Ok(())
+    }
+
+    fn demands_static(
+        scene: &Scene,
+        spec: &OctreeSpec,
+        sizing: &Sizing,
+        parts: &Particles,
+        dt: f64,
+        ctx_extra: Option<&SizingContext>,
+    ) -> Vec<SizeDemand> {
+        let base = SizingContext::new(spec.h_min(), spec.h_root);
+        let ctx = ctx_extra.copied().unwrap_or(base);
+        let (r_min, r_max) = (spec.h_min() / C_H, spec.h_root / C_H);
+        (0..parts.len())
+            .into_par_iter()
+            .filter(|&i| !parts.is_ballistic(i))
+            .map(|i| {
+                let s = sizing.radius_at_phi(&parts.x[i], Some(parts.phi[i]), &ctx).clamp(r_min, r_max);
+                let level = spec.level_for_size(C_H * s);
+                let h = spec.h(level);
+                let pad = (2.0 * h).max(f64::from(scene.flip.remesh_interval) * dt * parts.v[i].norm());
+                SizeDemand { center: parts.x[i], pad, level }
+            })
+            .collect()
+    }
+
+    fn walls(&self) -> [bool; 6] {
+        self.open.map(|o| !o)
+    }
+
+    fn level_set(&self) -> Vec<f64> {
+        let solid: Option<Vec<bool>> = self.mesh.solid_frac.as_ref().map(|w| {
+            (0..self.mesh.nodes.len())
+                .map(|i| self.mesh.node_tets.row(i).iter().all(|&t| w[t as usize] < W_MIN))
+                .collect()
+        });
+        let walls = Walls {
+            min: self.scene.min(),
+            max: self.scene.max(),
+            mirror: self.walls(),
+            node_in_solid: solid.as_deref(),
+        };
+        let mut phi = level_set_on_nodes(&self.mesh, &self.parts, &self.scene.surface, &walls);
+        redistance_first_layer(&self.mesh.nodes, &self.edges, &mut phi);
+        phi
+    }
+
+    /// Locates every particle (walking from its previous tet).
+    fn relocate(&mut self) {
+        let (mesh, oct) = (&self.mesh, &self.octree);
+        self.parts.tet.par_iter_mut().zip(self.parts.x.par_iter()).for_each(|(t, x)| {
+            *t = mesh.walk(oct, *t, x).map_or(NONE, |(tt, _)| tt);
+        });
+    }
+
+    /// Linear interpolation of the node level set at `x` in tet `t`.
+    fn phi_in(&self, t: u32, x: &Pt3) -> f64 {
+        let l = self.mesh.barycentric(t, x);
+        let tv = self.mesh.tets[t as usize];
+        (0..4).map(|a| l[a] * self.phi[tv[a] as usize]).sum()
+    }
+
+    fn phi_grad(&self, t: u32) -> Vec3 {
+        let tv = self.mesh.tets[t as usize];
+        let g = &self.mesh.grad_bary[t as usize];
+        (0..4).fold(Vec3::zeros(), |acc, a| acc + g[a] * self.phi[tv[a] as usize])
+    }
+
+    fn store_particle_phi(&mut self) {
+        let vals: Vec<f64> = (0..self.parts.len())
+            .into_par_iter()
+            .map(|i| {
+                let t = self.parts.tet[i];
+                if t == NONE {
+                    0.0
+                } else {
+                    self.phi_in(t, &self.parts.x[i])
+                }
+            })
+            .collect();
+        self.parts.phi = vals;
+    }
+
+    fn choose_dt(&self) -> f64 {
+        let f = &self.scene.flip;
+        let mut dt = match f.dt_policy {
+            DtPolicy::Fixed(dt) => dt,
+            DtPolicy::Adaptive => {
+                let m = (0..self.parts.len())
+                    .into_par_iter()
+                    .filter(|&i| !self.parts.is_ballistic(i) && self.parts.tet[i] != NONE)
+                    .map(|i| self.h_tet[self.parts.tet[i] as usize] / (self.parts.v[i].norm() + 1e-12))
+                    .reduce(|| f64::INFINITY, f64::min);
+                (f.cfl * m).clamp(f.dt_min, f.dt_max)
+            }
+        };
+        let next = (self.frame + 1) as f64 / self.scene.fps;
+        if self.time + dt >= next - 1e-9 * dt || self.time + 1.5 * dt > next {
+            let rem = next - self.time;
+            dt = if self.time + dt >= next - 1e-9 * dt { rem } else { 0.5 * rem };
+        }
+        dt.max(1e-12)
+    }
+
+    fn remesh(&mut self, dt: f64) -> Result<(usize, usize)> {
+        let needs_surface = self.sizing.needs_surface();
+        let curv = if needs_surface {
+            let tri = crate::surface::marching_tets(&self.mesh, &self.phi).ok();
+            tri.map(|m| {
+                let sm = crate::surface::smooth_surface(&m, self.scene.surface.smoothing_iterations);
+                let k = crate::surface::vertex_curvature(&sm, 1.0 / (2.0 * self.spec.h_min() / C_H));
+                SurfaceCurvature::new(&sm, k)
+            })
+        } else {
+            None
+        };
+        let mesh = &self.mesh;
+        let oct = &self.octree;
+        let nodal = &self.nodal_u;
+        let vort = |x: &Pt3| -> f64 {
+            match mesh.locate(oct, x) {
+                Some((t, _)) => {
+                    let tv = mesh.tets[t as usize];
+                    let g = &mesh.grad_bary[t as usize];
+                    (0..4).fold(Vec3::zeros(), |acc, a| acc + g[a].cross(&nodal[tv[a] as usize])).norm()
+                }
+                None => 0.0,
+            }
+        };
+        let solid = |x: &Pt3| self.scene.solid_sdf(x);
+        let mut ctx = SizingContext::new(self.spec.h_min(), self.spec.h_root);
+        ctx.time = self.time;
+        ctx.u_ref = (self.scene.g().norm() * self.h_ref.max(self.spec.h_min())).sqrt();
+        ctx.surface = curv.as_ref();
+        ctx.vorticity = Some(&vort);
+        if !self.scene.obstacles.is_empty() {
+            ctx.solid_sdf = Some(&solid);
+        }
+        let demands = Self::demands_static(&self.scene, &self.spec, &self.sizing, &self.parts, dt, Some(&ctx));
+        let mut oct = build_octree(self.spec, &demands);
+        if self.scene.extra_grading_layers > 0 {
+            balance_2to1(&mut oct, self.scene.extra_grading_layers);
+        }
+        let (mut ns, mut nm) = (0, 0);
+        // Keep the old mesh's φ for the split/merge snap.
+        if self.scene.particles.split_merge && self.spec.levels > 1 {
+            let (a, b) = self.split_merge(&oct)?;
+            ns = a;
+            nm = b;
+        }
+        self.set_mesh(oct)?;
+        for t in self.parts.tet.iter_mut() {
+            *t = NONE;
+        }
+        self.relocate();
+        self.phi = self.level_set();
+        Ok((ns, nm))
+    }
+
+    /// Split and merge against the new octree's leaf sizes (spec §3.10). Conserves `Σ r³` and
+    /// `Σ r³ v` exactly (before the surface snap).
+    fn split_merge(&mut self, new_oct: &Octree) -> Result<(usize, usize)> {
+        let pp = self.scene.particles.clone();
+        let target: Vec<f64> = self.parts.x.iter().map(|x| new_oct.leaf_h(new_oct.leaf_at(x)) / C_H).collect();
+        let mut n_split = 0;
+        // Split passes.
+        for _ in 0..9 {
+            let n0 = self.parts.len();
+            let mut any = false;
+            for i in 0..n0 {
+                if self.parts.is_ballistic(i) {
+                    continue;
+                }
+                let tr = new_oct.leaf_h(new_oct.leaf_at(&self.parts.x[i])) / C_H;
+                if self.parts.r[i] > pp.split_ratio * tr {
+                    if self.parts.len() >= pp.max_particles {
+                        self.budget_hit = true;
+                        if pp.budget_is_error {
+                            return Err(SimError::ParticleBudgetExceeded { limit: pp.max_particles });
+                        }
+                        break;
+                    }
+                    let r = self.parts.r[i];
+                    let rc = r / 2f64.cbrt();
+                    let off = self.rng.unit_vec3() * (0.5 * r * self.rng.f64());
+                    let x = self.parts.x[i];
+                    self.parts.x[i] = x + off;
+                    self.parts.r[i] = rc;
+                    let (v, phi) = (self.parts.v[i], self.parts.phi[i]);
+                    self.parts.push(x - off, v, rc, phi);
+                    let last = self.parts.len() - 1;
+                    self.parts.flags[last].0 |= ParticleFlags::NEW_THIS_REMESH;
+                    self.parts.flags[i].0 |= ParticleFlags::NEW_THIS_REMESH;
+                    self.parts.tet[last] = self.parts.tet[i];
+                    n_split += 1;
+                    any = true;
+                }
+            }
+            if !any {
+                break;
+            }
+        }
+        let _ = target;
+        // Merge passes: nearest untouched non-ballistic neighbour that also wants to merge.
+        let mut n_merge = 0;
+        for _ in 0..9 {
+            let tree = KdTree::build(&self.parts.x);
+            let n = self.parts.len();
+            let mut touched = vec![false; n];
+            let mut keep = vec![true; n];
+            let mut any = false;
+            let mut buf = Vec::new();
+            for i in 0..n {
+                if touched[i] || self.parts.is_ballistic(i) {
+                    continue;
+                }
+                let tr = new_oct.leaf_h(new_oct.leaf_at(&self.parts.x[i])) / C_H;
+                if self.parts.r[i] >= pp.merge_ratio * tr {
+                    continue;
+                }
+                tree.knn(&self.parts.x[i], 8, &mut buf);
+                let j = buf
+                    .iter()
+                    .map(|&(j, _)| j as usize)
+                    .find(|&j| j != i && !touched[j] && !self.parts.is_ballistic(j));
+                let Some(j) = j else { continue };
+                let (vi, vj) = (self.parts.r[i].powi(3), self.parts.r[j].powi(3));
+                let w = vi + vj;
+                self.parts.x[i] = Pt3::from((self.parts.x[i].coords * vi + self.parts.x[j].coords * vj) / w);
+                self.parts.v[i] = (self.parts.v[i] * vi + self.parts.v[j] * vj) / w;
+                self.parts.phi[i] = (self.parts.phi[i] * vi + self.parts.phi[j] * vj) / w;
+                self.parts.r[i] = w.cbrt();
+                self.parts.flags[i].0 |= ParticleFlags::NEW_THIS_REMESH;
+                touched[i] = true;
+                touched[j] = true;
+                keep[j] = false;
+                n_merge += 1;
+                any = true;
+            }
+            self.parts.retain(&keep);
+            if !any {
+                break;
+            }
+        }
+        // Surface snap of new particles (old mesh φ): −snap r < φ < 0 ⇒ tangent to the interface.
+        for i in 0..self.parts.len() {
+            if !self.parts.flags[i].has(ParticleFlags::NEW_THIS_REMESH) {
+                continue;
+            }
+            if let Some((t, _)) = self.mesh.walk(&self.octree, self.parts.tet[i], &self.parts.x[i]) {
+                let phi = self.phi_in(t, &self.parts.x[i]);
+                let r = self.parts.r[i];
+                let g = self.phi_grad(t);
+                if phi < 0.0 && phi > -pp.snap_factor * r && g.norm() > 0.0 {
+                    let n = g / g.norm();
+                    self.parts.x[i] -= n * (phi + r);
+                }
+            }
+        }
+        Ok((n_split, n_merge))
+    }
+
+    /// One adaptive time step (spec §3.1).
+    pub fn step(&mut self) -> Result<StepStats> {
+        let mut tm = PhaseTimings::default();
+        let mut st = StepStats { step: self.step, ..Default::default() };
+        let g = self.scene.g();
+        // 1. Ballistic classification, Δt.
+        let c = Instant::now();
+        let tree = KdTree::build(&self.parts.x);
+        st.n_ballistic = classify_ballistic(
+            &mut self.parts,
+            &tree,
+            self.scene.particles.ballistic_factor,
+            self.scene.particles.ballistic,
+        );
+        let dt = self.choose_dt();
+        tm.ballistic = c.elapsed().as_secs_f64();
+        // 2. Level set on the nodes, stored at particles.
+        let c = Instant::now();
+        self.phi = self.level_set();
+        self.store_particle_phi();
+        tm.levelset = c.elapsed().as_secs_f64();
+        // 3. Remesh.
+        if self.step > 0 && self.step.is_multiple_of(u64::from(self.scene.flip.remesh_interval)) {
+            let c = Instant::now();
+            let (ns, nm) = self.remesh(dt)?;
+            st.n_split = ns;
+            st.n_merge = nm;
+            st.remeshed = true;
+            self.store_particle_phi();
+            tm.remesh = c.elapsed().as_secs_f64();
+        }
+        let tree = if st.remeshed { KdTree::build(&self.parts.x) } else { tree };
+        let m = self.mesh.tets.len();
+        // 4–5. P2G and extrapolation.
+        let c = Instant::now();
+        let p2g = particles_to_tets(&self.mesh, &self.h_tet, &self.parts, &tree, &self.scene.transfer);
+        tm.p2g = c.elapsed().as_secs_f64();
+        let c = Instant::now();
+        let layers = self.scene.transfer.extrapolation_layers.unwrap_or(self.scene.flip.cfl.ceil() as u32 + 2);
+        let mut u_old = p2g.u.clone();
+        let mut valid = p2g.valid.clone();
+        extrapolate(&self.mesh, &mut u_old, &mut valid, layers);
+        blend_weak(&p2g, &mut u_old, &self.scene.transfer);
+        // Tets below the coverage threshold that nothing reached by extrapolation keep their own
+        // (weak) particle average instead of zero: a droplet cluster smaller than a cube has no
+        // valid tet at all and would otherwise lose its momentum every step (spec §8 H-DROPLET-8).
+        for t in 0..m {
+            if !valid[t] && p2g.coverage[t] > 0.0 {
+                u_old[t] = p2g.u[t];
+            }
+        }
+        tm.extrapolate = c.elapsed().as_secs_f64();
+        // 6. Forces.
+        let mut u = u_old.iter().map(|v| v + g * dt).collect::<Vec<_>>();
+        // 7. Pressure projection.
+        let c = Instant::now();
+        // Open box faces are free surfaces for the pressure (p = 0 there), so liquid can leave.
+        let phi_p: std::borrow::Cow<[f64]> = if self.open.iter().any(|&o| o) {
+            let mut f = self.phi.clone();
+            for (i, v) in f.iter_mut().enumerate() {
+                let b = self.mesh.node_boundary[i];
+                if (0..6).any(|k| self.open[k] && b & (1 << k) != 0) {
+                    *v = v.max(0.0);
+                }
+            }
+            std::borrow::Cow::Owned(f)
+        } else {
+            std::borrow::Cow::Borrowed(&self.phi)
+        };
+        let sys = assemble_pressure(&self.mesh, &phi_p, &u, self.spec.h_min(), &self.scene.pressure);
+        tm.assemble = c.elapsed().as_secs_f64();
+        let c = Instant::now();
+        let warm = self.warm.as_ref().map(|(nodes, q)| {
+            let mut w = vec![0.0; sys.rhs.len()];
+            let keymap: std::collections::HashMap<_, _> =
+                nodes.iter().zip(q).map(|(&k, &v)| (k, v)).collect::<std::collections::HashMap<u32, f64>>();
+            for (d, &node) in sys.node_of_dof.iter().enumerate() {
+                if let Some(v) = keymap.get(&node) {
+                    w[d] = *v;
+                }
+            }
+            w
+        });
+        let (q, rep) =
+            self.solver.solve(&sys, &self.scene.pressure, if st.remeshed { None } else { warm.as_deref() })?;
+        tm.solve = c.elapsed().as_secs_f64();
+        let c = Instant::now();
+        if q.iter().any(|v| !v.is_finite()) {
+            return Err(SimError::NonFinite { what: "pressure", step: self.step });
+        }
+        let updated = apply_pressure(&self.mesh, &sys, &q, &mut u);
+        self.warm = Some((sys.node_of_dof.clone(), q));
+        tm.apply = c.elapsed().as_secs_f64();
+        st.n_dofs = sys.rhs.len();
+        st.n_ghost_tets = sys.n_ghost_tets;
+        st.n_k_reduced = sys.n_k_reduced;
+        st.solver = rep;
+        // Valid after the projection: updated tets and tets holding a non-ballistic particle centre.
+        let c = Instant::now();
+        let mut valid_new = updated;
+        for i in 0..self.parts.len() {
+            let t = self.parts.tet[i];
+            if t != NONE && !self.parts.is_ballistic(i) {
+                valid_new[t as usize] = true;
+            }
+        }
+        let mut du: Vec<Vec3> = (0..m).map(|t| u[t] - u_old[t]).collect();
+        let mut valid_du = valid_new.clone();
+        extrapolate(&self.mesh, &mut u, &mut valid_new, layers);
+        extrapolate(&self.mesh, &mut du, &mut valid_du, layers);
+        let wall_mask = (0..6).filter(|&k| !self.open[k]).fold(0u8, |m, k| m | (1 << k));
+        let nodal_new = node_average(&self.mesh, &u, wall_mask);
+        let nodal_du = node_average(&self.mesh, &du, wall_mask);
+        tm.extrapolate += c.elapsed().as_secs_f64();
+        // 9. G2P.
+        let c = Instant::now();
+        let fp = &self.scene.flip;
+        let r_min = self.spec.h_min() / C_H;
+        {
+            let mesh = &self.mesh;
+            let (u_r, nn, du_r, nd) = (&u, &nodal_new, &du, &nodal_du);
+            let parts = &mut self.parts;
+            let (xs, vs, rs, ts, fl) = (&parts.x, &mut parts.v, &parts.r, &parts.tet, &parts.flags);
+            vs.par_iter_mut().enumerate().for_each(|(i, v)| {
+                if fl[i].has(ParticleFlags::BALLISTIC) || ts[i] == NONE {
+                    return;
+                }
+                let l = mesh.barycentric(ts[i], &xs[i]);
+                let a = pic_fraction(rs[i], r_min, fp.pic_base, fp.pic_radius_exponent, fp.pic_floor);
+                let vn = sample(mesh, u_r, nn, ts[i], &l);
+                let dv = sample(mesh, du_r, nd, ts[i], &l);
+                *v = vn * a + (*v + dv) * (1.0 - a);
+            });
+        }
+        tm.g2p = c.elapsed().as_secs_f64();
+        // 10. Advection (RK2 with substeps), ballistic free flight, walls, obstacles.
+        let c = Instant::now();
+        let subs: Vec<u32> = {
+            let mesh = &self.mesh;
+            let oct = &self.octree;
+            let h_tet = &self.h_tet;
+            let (u_r, nn) = (&u, &nodal_new);
+            let parts = &mut self.parts;
+            let (xs, vs, rs, ts, fl) = (&mut parts.x, &mut parts.v, &parts.r, &mut parts.tet, &parts.flags);
+            xs.par_iter_mut()
+                .zip(vs.par_iter_mut())
+                .zip(ts.par_iter_mut())
+                .enumerate()
+                .map(|(i, ((x, v), t))| {
+                    let _ = rs;
+                    if fl[i].has(ParticleFlags::BALLISTIC) || *t == NONE {
+                        *v += g * dt;
+                        *x += *v * dt;
+                        return 0;
+                    }
+                    let h = h_tet[*t as usize];
+                    let n = ((v.norm() * dt) / (0.5 * h)).ceil().clamp(1.0, 64.0) as u32;
+                    let sdt = dt / f64::from(n);
+                    let vel = |p: &Pt3, hint: u32| -> (Vec3, u32) {
+                        match mesh.walk(oct, hint, p) {
+                            Some((tt, l)) => (sample(mesh, u_r, nn, tt, &l), tt),
+                            None => (Vec3::zeros(), hint),
+                        }
+                    };
+                    for _ in 0..n {
+                        let (v1, t1) = vel(x, *t);
+                        let mid = *x + v1 * (0.5 * sdt);
+                        let (v2, t2) = vel(&mid, t1);
+                        *x += v2 * sdt;
+                        *t = t2;
+                    }
+                    n - 1
+                })
+                .collect()
+        };
+        st.cfl_substeps = subs.iter().sum();
+        let keep = apply_walls(&mut self.parts, &self.scene.min(), &self.scene.max(), &self.open);
+        if !self.scene.obstacles.is_empty() {
+            let sc = &self.scene;
+            apply_obstacles(&mut self.parts, &|x: &Pt3| sc.solid_sdf(x));
+        }
+        let deleted = keep.iter().filter(|&&k| !k).count();
+        if deleted > 0 {
+            self.deleted_volume +=
+                (0..self.parts.len()).filter(|&i| !keep[i]).map(|i| self.parts.volume(i)).sum::<f64>();
+            self.parts.retain(&keep);
+        }
+        st.n_deleted = deleted;
+        self.relocate();
+        tm.advect = c.elapsed().as_secs_f64();
+        // 11. Position correction.
+        let c = Instant::now();
+        if self.scene.particles.position_correction && !self.parts.is_empty() {
+            let band = self.scene.particles.surface_band_factor;
+            let normals: Vec<Option<Vec3>> = (0..self.parts.len())
+                .map(|i| {
+                    let t = self.parts.tet[i];
+                    if t == NONE || self.parts.phi[i] <= -band * self.parts.r[i] {
+                        return None;
+                    }
+                    let gr = self.phi_grad(t);
+                    let n = gr.norm();
+                    (n > 0.0).then(|| gr / n)
+                })
+                .collect();
+            let tree = KdTree::build(&self.parts.x);
+            let closed = self.walls();
+            let seed = self.scene.seed ^ self.step.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            position_correction(
+                &mut self.parts,
+                &tree,
+                &self.scene.min(),
+                &self.scene.max(),
+                &closed,
+                &normals,
+                self.scene.particles.correction_gamma,
+                seed,
+            );
+            let _ = apply_walls(&mut self.parts, &self.scene.min(), &self.scene.max(), &[false; 6]);
+            self.relocate();
+        }
+        tm.correction = c.elapsed().as_secs_f64();
+        self.nodal_u = nodal_new;
+        // Statistics.
+        self.time += dt;
+        self.step += 1;
+        let next = (self.frame + 1) as f64 / self.scene.fps;
+        if self.time >= next - 1e-9 * dt.max(1e-12) {
+            self.frame += 1;
+            st.frame_end = true;
+        }
+        if self.parts.x.iter().any(|x| !x.coords.iter().all(|c| c.is_finite()))
+            || self.parts.v.iter().any(|v| !v.iter().all(|c| c.is_finite()))
+        {
+            return Err(SimError::NonFinite { what: "particles", step: st.step });
+        }
+        st.t = self.time;
+        st.dt = dt;
+        st.n_particles = self.parts.len();
+        st.n_nodes = self.mesh.nodes.len();
+        st.n_tets = self.mesh.tets.len();
+        st.vol_particles = self.parts.total_volume();
+        st.vol_levelset = liquid_volume(&self.mesh, &self.phi);
+        let (ke, pe, vmax) = (0..self.parts.len()).fold((0.0, 0.0, 0.0f64), |(k, p, m), i| {
+            let mass = RHO * self.parts.volume(i);
+            let s = self.parts.v[i].norm();
+            (k + 0.5 * mass * s * s, p - mass * g.dot(&self.parts.x[i].coords), m.max(s))
+        });
+        st.kinetic_energy = ke;
+        st.potential_energy = pe;
+        st.max_speed = vmax;
+        st.timings = tm;
+        Ok(st)
+    }
+
+    /// Steps until `time ≥ t` (frame times are landed on exactly).
+    pub fn advance_to(&mut self, t: f64) -> Result<Vec<StepStats>> {
+        let mut out = Vec::new();
+        while self.time < t - 1e-9 {
+            out.push(self.step()?);
+        }
+        Ok(out)
+    }
+
+    /// Simulation surface by marching tetrahedra on the node level set (spec §3.11.4); `None`
+    /// when there is no liquid surface.
+    pub fn surface(&self) -> Option<TriMesh> {
+        crate::surface::marching_tets(&self.mesh, &self.phi).ok()
+    }
+
+    /// Particles.
+    pub fn particles(&self) -> &Particles {
+        &self.parts
+    }
+    /// Mutable particles (tests, stress cases).
+    pub fn particles_mut(&mut self) -> &mut Particles {
+        &mut self.parts
+    }
+    /// Tet mesh.
+    pub fn mesh(&self) -> &TetMesh {
+        &self.mesh
+    }
+    /// Octree.
+    pub fn octree(&self) -> &Octree {
+        &self.octree
+    }
+    /// Node level set of the last step (m).
+    pub fn phi(&self) -> &[f64] {
+        &self.phi
+    }
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.step
+    }
+    /// The scene.
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+    /// Octree resolution.
+    pub fn spec(&self) -> &OctreeSpec {
+        &self.spec
+    }
+}

@@ -1,0 +1,313 @@
+//! Level set of the liquid on the mesh nodes from particles of varying radius (spec §3.11.3):
+//! triplet-hull union near the surface, coarse sphere union elsewhere, interior redistancing by
+//! edge-path distance, mirrored particles at closed box walls, extension into obstacles.
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+
+use geom_core::graph::Ragged;
+use geom_core::math::Pt3;
+use geom_core::spatial::KdTree;
+use rayon::prelude::*;
+
+use super::hull::{facet_distance, pair_distance};
+use super::volume::tet_volume;
+use super::{SurfaceMethod, SurfaceParams};
+use crate::bcc::TetMesh;
+use crate::particles::{ParticleFlags, Particles};
+
+/// Box walls and obstacles as seen by the level set (spec §3.11.3, §12 G16).
+#[derive(Clone, Copy, Debug)]
+pub struct Walls<'a> {
+    /// Domain box minimum corner (m).
+    pub min: Pt3,
+    /// Domain box maximum corner (m).
+    pub max: Pt3,
+    /// Closed walls that mirror particles, order −x, +x, −y, +y, −z, +z (open faces: `false`).
+    pub mirror: [bool; 6],
+    /// Per-node flag "inside a solid obstacle"; such nodes take the average φ of their non-solid
+    /// edge neighbours (one sweep) so the liquid sees no free surface along the obstacle.
+    pub node_in_solid: Option<&'a [bool]>,
+}
+
+impl Walls<'_> {
+    /// Walls that mirror nothing and no obstacles (a free-standing particle set).
+    pub fn none() -> Walls<'static> {
+        Walls { min: Pt3::origin(), max: Pt3::origin(), mirror: [false; 6], node_in_solid: None }
+    }
+}
+
+/// One source sphere of the level set (a particle or a mirrored copy).
+#[derive(Clone, Copy, Debug)]
+struct Source {
+    x: Pt3,
+    /// Radius used for the shapes: `r_temp = max(r, −k φ_p)` (m).
+    r: f64,
+    near: bool,
+}
+
+/// Evaluates the particle level set at arbitrary points (spec §3.11.3, without the interior
+/// redistancing, which needs mesh edges): build once per particle configuration, then query.
+#[derive(Debug)]
+pub struct LevelSetSampler {
+    src: Vec<Source>,
+    all: KdTree,
+    near_idx: Vec<u32>,
+    near: KdTree,
+    /// Largest particle radius (original `r`, not `r_temp`): sets the band and search radius.
+    r_max: f64,
+    params: SurfaceParams,
+}
+
+impl LevelSetSampler {
+    /// Collects the non-ballistic particles with their interior radii `max(r, −k φ_p)` (`φ_p` from
+    /// `parts.phi`; missing or non-finite values count as surface particles, `r_temp = r`) and their
+    /// mirror copies across the closed walls within `2 l r_p` (spec §3.11.3).
+    pub fn new(parts: &Particles, params: &SurfaceParams, walls: &Walls) -> Self {
+        let mut src = Vec::with_capacity(parts.len());
+        let mut r_max: f64 = 0.0;
+        for i in 0..parts.len() {
+            if parts.flags.get(i).is_some_and(|f| f.has(ParticleFlags::BALLISTIC)) {
+                continue;
+            }
+            let r = parts.r[i];
+            let phi = parts.phi.get(i).copied().filter(|v| v.is_finite());
+            let r_temp = phi.map_or(r, |p| r.max(-params.interior_k * p));
+            let near = phi.is_none_or(|p| p > -params.near_surface_band * r);
+            src.push(Source { x: parts.x[i], r: r_temp, near });
+            r_max = r_max.max(r);
+        }
+        // Mirror axis by axis so particles near an edge or corner get all their images.
+        for axis in 0..3 {
+            let n0 = src.len();
+            for s in 0..n0 {
+                let Source { x, r, near } = src[s];
+                let reach = 2.0 * params.hull_l * r;
+                for (side, wall) in [(0, walls.min[axis]), (1, walls.max[axis])] {
+                    if walls.mirror[2 * axis + side] && (x[axis] - wall).abs() < reach {
+                        let mut y = x;
+                        y[axis] = 2.0 * wall - x[axis];
+                        src.push(Source { x: y, r, near });
+                    }
+                }
+            }
+        }
+        let pts: Vec<Pt3> = src.iter().map(|s| s.x).collect();
+        let all = KdTree::build(&pts);
+        let near_idx: Vec<u32> = (0..src.len() as u32).filter(|&i| src[i as usize].near).collect();
+        let near_pts: Vec<Pt3> = near_idx.iter().map(|&i| pts[i as usize]).collect();
+        let near = KdTree::build(&near_pts);
+        Self { src, all, near_idx, near, r_max, params: params.clone() }
+    }
+
+    /// Number of source spheres (particles plus mirror images).
+    pub fn n_sources(&self) -> usize {
+        self.src.len()
+    }
+
+    /// Largest particle radius `r` (not the interior radius) among the sources (m).
+    pub fn r_max(&self) -> f64 {
+        self.r_max
+    }
+
+    /// The band half-width at a node of local mesh size `h` (m): `max(3 h, 6 r_max)`.
+    pub fn band(&self, h: f64) -> f64 {
+        (3.0 * h).max(6.0 * self.r_max)
+    }
+
+    /// Level-set value at `q` (m, negative inside) for a point whose local mesh size is `h` (m);
+    /// values beyond the band are clamped to `±band` (spec §3.11.3). With no sources, `+band`.
+    pub fn value(&self, q: &Pt3, h: f64) -> f64 {
+        let band = self.band(h);
+        if self.src.is_empty() {
+            return band;
+        }
+        let l = self.params.hull_l;
+        let search = 2.0 * l * self.r_max + band;
+        let mut buf = Vec::new();
+        self.all.within(q, search, &mut buf);
+        let phi_s = buf.iter().map(|&i| {
+            let s = &self.src[i as usize];
+            (q - s.x).norm() - s.r
+        });
+        let phi_s = phi_s.fold(f64::INFINITY, f64::min);
+        if phi_s.is_nan() || phi_s.abs() > band {
+            return phi_s.clamp(-band, band);
+        }
+        match self.params.method {
+            SurfaceMethod::SphereUnion => phi_s,
+            SurfaceMethod::ZhuBridson => self.zhu_bridson(q, &buf).unwrap_or(phi_s),
+            SurfaceMethod::Hulls => phi_s.min(self.hulls(q)),
+        }
+    }
+
+    /// Zhu–Bridson averaged sphere (the fixed-radius comparison, spec S8): kernel
+    /// `w = (1 − d²/R²)³` with `R = 2 r_max`, `φ = |q − x̄| − r̄`; `None` when no particle is
+    /// within `R`.
+    fn zhu_bridson(&self, q: &Pt3, cand: &[u32]) -> Option<f64> {
+        let big_r = 2.0 * self.r_max;
+        let (mut wsum, mut xs, mut rs) = (0.0, Pt3::origin().coords, 0.0);
+        for &i in cand {
+            let s = &self.src[i as usize];
+            let d2 = (q - s.x).norm_squared() / (big_r * big_r);
+            if d2 < 1.0 {
+                let w = (1.0 - d2).powi(3);
+                wsum += w;
+                xs += s.x.coords * w;
+                rs += s.r * w;
+            }
+        }
+        (wsum > 0.0).then(|| (q.coords - xs / wsum).norm() - rs / wsum)
+    }
+
+    /// Union of spheres, round cones of connected pairs and valid triplet hulls among the `K`
+    /// nearest near-surface sources (spec §3.11.1–3.11.3).
+    fn hulls(&self, q: &Pt3) -> f64 {
+        let mut knn = Vec::new();
+        self.near.knn(q, self.params.neighbours as usize, &mut knn);
+        let s: Vec<Source> = knn.iter().map(|&(j, _)| self.src[self.near_idx[j as usize] as usize]).collect();
+        let k = s.len();
+        let l = self.params.hull_l;
+        let mut best = f64::INFINITY;
+        for a in &s {
+            best = best.min((q - a.x).norm() - a.r);
+        }
+        // Connectivity matrix (K ≤ 32, so a flat vector).
+        let mut conn = vec![false; k * k];
+        for i in 0..k {
+            for j in (i + 1)..k {
+                let (a, b) = (&s[i], &s[j]);
+                let d = (a.x - b.x).norm();
+                if d < l * (a.r + b.r) && d > 0.0 {
+                    conn[i * k + j] = true;
+                    best = best.min(pair_distance(q, &a.x, &b.x, a.r, b.r));
+                }
+            }
+        }
+        for i in 0..k {
+            for j in (i + 1)..k {
+                if !conn[i * k + j] {
+                    continue;
+                }
+                for m in (j + 1)..k {
+                    if conn[i * k + m] && conn[j * k + m] {
+                        let (a, b, c) = (&s[i], &s[j], &s[m]);
+                        if let Some(f) = facet_distance(q, &[a.x, b.x, c.x], &[a.r, b.r, c.r]) {
+                            best = best.min(f);
+                        }
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Local mesh size per node: the largest `(12 V)^{1/3}` over its incident tets (the cube edge of
+/// a regular BCC tet), m. Nodes in no tet get 0.
+pub fn node_sizes(mesh: &TetMesh) -> Vec<f64> {
+    let mut h = vec![0.0f64; mesh.nodes.len()];
+    for t in &mesh.tets {
+        let [a, b, c, d] = t.map(|i| mesh.nodes[i as usize]);
+        let s = (12.0 * tet_volume(&a, &b, &c, &d)).cbrt();
+        for &i in t {
+            h[i as usize] = h[i as usize].max(s);
+        }
+    }
+    h
+}
+
+/// Node adjacency along the mesh edges (sorted, deduplicated rows).
+pub fn node_edges(mesh: &TetMesh) -> Ragged<u32> {
+    let mut pairs: Vec<(u32, u32)> = Vec::with_capacity(mesh.tets.len() * 12);
+    for t in &mesh.tets {
+        for a in 0..4 {
+            for b in 0..4 {
+                if a != b {
+                    pairs.push((t[a], t[b]));
+                }
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs.dedup();
+    Ragged::from_pairs(mesh.nodes.len(), &pairs)
+}
+
+/// Liquid level set at every mesh node (m, negative inside), spec §3.11.3: the method of
+/// `params.method` within the band `max(3 h, 6 r_max)`, clamped outside it, then interior
+/// redistancing (every value `≤ −band` replaced by minus the multi-source shortest edge-path
+/// distance from the band nodes, §12 G19), then one extension sweep into solid nodes.
+///
+/// Only the non-ballistic particles contribute (`parts.flags`); `parts.phi` supplies the stored
+/// level set for the interior radii. Parallel per node, bitwise deterministic.
+pub fn level_set_on_nodes(mesh: &TetMesh, parts: &Particles, params: &SurfaceParams, walls: &Walls) -> Vec<f64> {
+    let sampler = LevelSetSampler::new(parts, params, walls);
+    let h = node_sizes(mesh);
+    let mut phi: Vec<f64> = mesh.nodes.par_iter().zip(h.par_iter()).map(|(q, &hq)| sampler.value(q, hq)).collect();
+    let edges = node_edges(mesh);
+    let bands: Vec<f64> = h.iter().map(|&hq| sampler.band(hq)).collect();
+    redistance_interior(&mesh.nodes, &edges, &bands, &mut phi);
+    if let Some(solid) = walls.node_in_solid {
+        extend_into_solids(&edges, solid, &mut phi);
+    }
+    phi
+}
+
+/// Replaces every `φ_i ≤ −band_i` by `−d_i`, `d` the multi-source Dijkstra distance along mesh
+/// edges seeded with `−φ` at the band nodes (`−band < φ ≤ 0`). Unreached nodes keep their value.
+pub fn redistance_interior(nodes: &[Pt3], edges: &Ragged<u32>, band: &[f64], phi: &mut [f64]) {
+    let deep: Vec<bool> = phi.iter().zip(band).map(|(&p, &b)| p <= -b).collect();
+    if !deep.iter().any(|&d| d) {
+        return;
+    }
+    let mut dist = vec![f64::INFINITY; phi.len()];
+    // Distances are non-negative, so their IEEE bit patterns order like the values.
+    let mut heap = BinaryHeap::new();
+    for i in 0..phi.len() {
+        if !deep[i] && phi[i] <= 0.0 {
+            dist[i] = -phi[i];
+            heap.push(Reverse((dist[i].to_bits(), i as u32)));
+        }
+    }
+    while let Some(Reverse((bits, i))) = heap.pop() {
+        let d = f64::from_bits(bits);
+        if d > dist[i as usize] {
+            continue;
+        }
+        for &j in edges.row(i as usize) {
+            if !deep[j as usize] {
+                continue;
+            }
+            let nd = d + (nodes[j as usize] - nodes[i as usize]).norm();
+            if nd < dist[j as usize] {
+                dist[j as usize] = nd;
+                heap.push(Reverse((nd.to_bits(), j)));
+            }
+        }
+    }
+    for i in 0..phi.len() {
+        if deep[i] && dist[i].is_finite() {
+            phi[i] = -dist[i];
+        }
+    }
+}
+
+/// One Jacobi sweep: every solid node takes the average φ of its non-solid edge neighbours
+/// (spec §3.11.3 "Obstacles"); solid nodes with no such neighbour keep their value.
+pub fn extend_into_solids(edges: &Ragged<u32>, solid: &[bool], phi: &mut [f64]) {
+    let old = phi.to_vec();
+    for (i, p) in phi.iter_mut().enumerate() {
+        if !solid.get(i).copied().unwrap_or(false) {
+            continue;
+        }
+        let (s, n) = edges
+            .row(i)
+            .iter()
+            .filter(|&&j| !solid.get(j as usize).copied().unwrap_or(false))
+            .fold((0.0, 0usize), |(s, n), &j| (s + old[j as usize], n + 1));
+        if n > 0 {
+            *p = s / n as f64;
+        }
+    }
+}

@@ -1,0 +1,153 @@
+//! Spec §7 pressure tests: T-GHOST-SYM, T-HYDRO-ONESTEP (incl. T-GHOST-LINEAR on the nodes),
+//! T-PROJ-DIVFREE, T-NULLSPACE, T-K-RULE (regular tets keep k = 1; SPD with k applied).
+
+use flip_tet::bcc::{tetrahedralize, TetMesh};
+use flip_tet::octree::{build_octree, Octree, OctreeSpec, SizeDemand};
+use flip_tet::ops::divergence;
+use flip_tet::pressure::{apply_pressure, assemble_pressure, PressureParams, PressureSolver};
+use geom_core::math::{Pt3, Vec3};
+use geom_core::rng::Rng;
+use geom_core::NONE;
+
+fn uniform(n: u32) -> (Octree, TetMesh) {
+    let sp = OctreeSpec::new(Pt3::origin(), Pt3::new(1.0, 1.0, 0.5), n, n).unwrap();
+    let oct = Octree::uniform(sp, 0);
+    let m = tetrahedralize(&oct).unwrap();
+    (oct, m)
+}
+
+/// Depth-graded mesh with the finest level around the plane y = h.
+fn graded(h: f64) -> (Octree, TetMesh) {
+    let sp = OctreeSpec::new(Pt3::origin(), Pt3::new(1.0, 1.0, 0.5), 4, 16).unwrap();
+    let mut d = Vec::new();
+    for i in 0..=20 {
+        for k in 0..=10 {
+            d.push(SizeDemand { center: Pt3::new(i as f64 / 20.0, h, k as f64 / 20.0), pad: 0.2, level: 2 });
+        }
+    }
+    let oct = build_octree(sp, &d);
+    let m = tetrahedralize(&oct).unwrap();
+    (oct, m)
+}
+
+fn hydro_check(m: &TetMesh, h: f64, h_min: f64) -> f64 {
+    let dt = 1.0 / 120.0;
+    let phi: Vec<f64> = m.nodes.iter().map(|p| p.y - h).collect();
+    let ustar = vec![Vec3::new(0.0, -9.81 * dt, 0.0); m.tets.len()];
+    let p = PressureParams::default();
+    let sys = assemble_pressure(m, &phi, &ustar, h_min, &p);
+    assert!(sys.matrix.is_symmetric(1e-13 * sys.matrix.max_abs()));
+    let mut solver = PressureSolver::default();
+    let (q, rep) = solver.solve(&sys, &p, None).unwrap();
+    assert!(rep.rel_residual < 1e-10);
+    // Exact nodal values q = Δt g (h − y) = −Δt g φ (T-GHOST-LINEAR).
+    for (d, &node) in sys.node_of_dof.iter().enumerate() {
+        let want = -9.81 * dt * phi[node as usize];
+        assert!((q[d] - want).abs() <= 1e-10 * (9.81 * dt), "node {node}: {} vs {want}", q[d]);
+    }
+    let mut u = ustar.clone();
+    let upd = apply_pressure(m, &sys, &q, &mut u);
+    let mut worst: f64 = 0.0;
+    for t in 0..m.tets.len() {
+        if upd[t] {
+            worst = worst.max(u[t].norm());
+        }
+    }
+    worst
+}
+
+#[test]
+fn t_hydro_onestep_uniform_and_graded() {
+    let (_, m) = uniform(8);
+    // Surface strictly between node planes, and exactly on a node plane (S1a).
+    for h in [0.43, 0.5, 0.5625] {
+        let w = hydro_check(&m, h, 0.125);
+        assert!(w <= 1e-12, "h = {h}: max |u| = {w}");
+    }
+    let (_, g) = graded(0.53);
+    let w = hydro_check(&g, 0.53, 1.0 / 16.0);
+    assert!(w <= 1e-12, "graded: max |u| = {w}");
+}
+
+#[test]
+fn t_ghost_sym_and_k_rule_random_interfaces() {
+    let (oct, m) = graded(0.5);
+    let mut rng = Rng::new(11);
+    let p = PressureParams::default();
+    for _ in 0..30 {
+        let c = Pt3::new(rng.range(0.2, 0.8), rng.range(0.3, 0.7), rng.range(0.1, 0.4));
+        let r = rng.range(0.1, 0.3);
+        let phi: Vec<f64> = m.nodes.iter().map(|x| (x - c).norm() - r).collect();
+        let ustar: Vec<Vec3> = (0..m.tets.len()).map(|_| rng.unit_vec3()).collect();
+        let sys = assemble_pressure(&m, &phi, &ustar, oct.spec.h_min(), &p);
+        assert!(sys.matrix.is_symmetric(1e-13 * sys.matrix.max_abs().max(1e-300)));
+        // SPD: the direct factorisation succeeds.
+        let mut s = PressureSolver::default();
+        let (q, _) = s.solve(&sys, &p, None).unwrap();
+        // T-PROJ-DIVFREE: liquid rows of D u vanish after the update with the same ghosts.
+        let mut u = ustar.clone();
+        apply_pressure(&m, &sys, &q, &mut u);
+        let du = divergence(&m, &u);
+        let bn: f64 = sys.rhs.iter().map(|v| v * v).sum::<f64>().sqrt();
+        for (d, &node) in sys.node_of_dof.iter().enumerate() {
+            if !sys.pinned.contains(&(d as u32)) {
+                assert!(du[node as usize].abs() <= 1e-9 * bn, "row {d}: {}", du[node as usize]);
+            }
+        }
+        // Regular BCC tets always keep k = 1: every reduced tet is a transition tet (level jump).
+        assert!(sys.n_k_reduced <= sys.n_ghost_tets);
+    }
+    // On a uniform mesh no interface tet is reduced.
+    let (_, u8m) = uniform(8);
+    for _ in 0..20 {
+        let c = Pt3::new(rng.range(0.3, 0.7), rng.range(0.3, 0.7), rng.range(0.2, 0.3));
+        let phi: Vec<f64> = u8m.nodes.iter().map(|x| (x - c).norm() - rng.range(0.15, 0.3)).collect();
+        let ustar = vec![Vec3::zeros(); u8m.tets.len()];
+        let sys = assemble_pressure(&u8m, &phi, &ustar, 0.125, &p);
+        let interior_reduced =
+            sys.ghosts.iter().filter(|g| g.scale == 0.0 && g.theta.iter().any(|&t| t != 0.0)).count();
+        assert_eq!(interior_reduced, 0);
+    }
+}
+
+#[test]
+fn t_nullspace_full_box_and_projection_idempotent() {
+    let (oct, m) = uniform(4);
+    let phi = vec![-1.0; m.nodes.len()];
+    let mut rng = Rng::new(5);
+    let ustar: Vec<Vec3> = (0..m.tets.len()).map(|_| rng.unit_vec3()).collect();
+    let p = PressureParams::default();
+    let sys = assemble_pressure(&m, &phi, &ustar, oct.spec.h_min(), &p);
+    assert_eq!(sys.pinned.len(), 1);
+    let mut s = PressureSolver::default();
+    let (q, _) = s.solve(&sys, &p, None).unwrap();
+    let mut u = ustar.clone();
+    apply_pressure(&m, &sys, &q, &mut u);
+    // Projecting twice changes nothing (1e-10).
+    let sys2 = assemble_pressure(&m, &phi, &u, oct.spec.h_min(), &p);
+    let (q2, _) = s.solve(&sys2, &p, None).unwrap();
+    let mut u2 = u.clone();
+    apply_pressure(&m, &sys2, &q2, &mut u2);
+    let change = u.iter().zip(&u2).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+    assert!(change <= 1e-10, "{change}");
+    assert_eq!(s.n_analyses, 1, "symbolic analysis reused for the same pattern");
+    assert!(sys.dof_of_node.iter().all(|&d| d != NONE));
+}
+
+#[test]
+fn pcg_agrees_with_direct() {
+    let (oct, m) = graded(0.5);
+    let phi: Vec<f64> = m.nodes.iter().map(|p| p.y - 0.61).collect();
+    let ustar: Vec<Vec3> = m.centroid.iter().map(|c| Vec3::new(c.y.sin(), -1.0, c.x)).collect();
+    let mut p = PressureParams::default();
+    let sys = assemble_pressure(&m, &phi, &ustar, oct.spec.h_min(), &p);
+    let (qd, _) = PressureSolver::default().solve(&sys, &p, None).unwrap();
+    p.solver = flip_tet::error::SolverKind::PcgIc0;
+    p.tol = 1e-10;
+    let (qi, rep) = PressureSolver::default().solve(&sys, &p, None).unwrap();
+    assert!(rep.iters > 0);
+    let scale = qd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for (a, b) in qd.iter().zip(&qi) {
+        assert!((a - b).abs() <= 1e-6 * scale);
+    }
+}

@@ -1,0 +1,532 @@
+//! Guided seed paths (ours; motion-graph.md §13 suggests a small best-first search over the graph
+//! to seed paths, compared there with the random seeds of §3.7).
+//!
+//! A beam search over *checkpoints*: the output times of the body, joint and hard constraints,
+//! the last frame `F* − 1`, and virtual checkpoints so that no two are more than
+//! [`GuidedParams::max_gap`] frames apart. A beam state is a placed partial path (current piece:
+//! clip, entry frame and time, placement `W`, §3.5). From each state every extension to the next
+//! checkpoint time `t_c` with 0 cuts (stay in the clip), 1 cut (every leaf edge leaving the piece
+//! early enough) or 2 cuts (sampled first edges × sampled second edges) is placed exactly and
+//! ranked by the score terms of eq. 1 it fixes (`w_p‖x − x*‖² + w_o Δyaw²` for body constraints,
+//! `w_j‖p − p*‖²` for joint constraints, `w_c cost(e)` for the cuts). At intermediate checkpoints
+//! errors within a slack (0.15 m, 5°) rank alike, so the beam keeps diverse speeds and headings
+//! instead of the last centimetre; the exact terms are accumulated separately and rank the last
+//! checkpoint. A hard constraint at `t_c` is a filter (§3.7: exact) and its two-cut extensions are
+//! exhaustive (every first edge × every top edge into a clip holding a matching frame: the
+//! one-hop landing of §3.7). Checkpoints without constraints are ranked additionally by the
+//! distance to the point interpolated between the neighbouring body constraints beyond a free
+//! radius (half the distance left, so detours stay possible) and, before a hard constraint, by
+//! the clip-level hops still needed to reach a clip that meets it. The `width` best extensions
+//! with distinct `(clip, frame)` at `t_c`, at most `per_parent` per state, form the next beam.
+//! The complete paths are scored with [`crate::path::score`] and enter the population; the
+//! randomized search (§3.8) refines them.
+//!
+//! Cost: `O(#checkpoints · width · (edges per piece + draws²))` placements of two planar
+//! transforms each — a few tens of milliseconds for MG-1 (300 frames, 18k database frames).
+
+use crate::graph::{EdgeId, FrameRef, MotionGraph};
+use crate::path::{hard_ok, score, Compiled, Hard, Path, Scored};
+use geom_core::math::{wrap_angle, Planar};
+use geom_core::rng::Rng;
+use serde::{Deserialize, Serialize};
+use std::collections::HashSet;
+
+/// Parameters of the guided seeds.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GuidedParams {
+    /// Beam width (complete paths returned at most; 0 disables guided seeds). Default 24.
+    pub width: usize,
+    /// First edges drawn per state for two-cut extensions. Default 24.
+    pub first_draws: usize,
+    /// Second edges drawn per first edge (at a hard constraint additionally every top edge into
+    /// a matching clip). Default 12.
+    pub second_draws: usize,
+    /// Largest gap between checkpoints (frames); longer gaps get virtual checkpoints. Default 100.
+    pub max_gap: u32,
+    /// Weight of the interpolated guide point at checkpoints without a body constraint, relative
+    /// to `w_p`. Default 0.25.
+    pub guide_weight: f64,
+    /// Random start frames tried, as a multiple of `width` (the first checkpoint chooses among
+    /// them). Default 8.
+    pub start_factor: usize,
+    /// Most children one state may leave in the next beam (diversity). Default 4.
+    pub per_parent: usize,
+    /// Body position error (m) that costs nothing in the ranking at intermediate checkpoints, so
+    /// that states within it are chosen at random (diverse speeds and headings) rather than by
+    /// the last centimetre. Default 0.15.
+    pub slack_m: f64,
+    /// Heading error (deg) free in the ranking at intermediate checkpoints. Default 5.
+    pub slack_deg: f64,
+    /// Free radius around the guide point as a fraction of the distance left to the next body
+    /// constraint (detours allowed). Default 0.5.
+    pub guide_slack: f64,
+    /// Run the beam again (fresh random starts and draws) every this many search iterations and
+    /// add its results to the population (0 = only at the start). Default 2.
+    pub every: usize,
+}
+
+impl Default for GuidedParams {
+    fn default() -> Self {
+        Self {
+            width: 24,
+            first_draws: 24,
+            second_draws: 12,
+            max_gap: 40,
+            guide_weight: 0.25,
+            start_factor: 8,
+            per_parent: 4,
+            slack_m: 0.15,
+            slack_deg: 5.0,
+            guide_slack: 0.5,
+            every: 2,
+        }
+    }
+}
+
+/// One checkpoint of the beam.
+struct Checkpoint {
+    t: u32,
+    /// Indices of the body constraints evaluated here.
+    body: Vec<usize>,
+    /// Indices of the joint constraints evaluated here.
+    joints: Vec<usize>,
+    hard: Option<Hard>,
+    /// Clips holding at least one frame that meets `hard` (empty without a hard constraint).
+    hard_clips: Vec<u32>,
+    /// Before a hard constraint: per clip, the number of clip-level hops (top edges) to a clip
+    /// that meets it; ranked as [`HOP_PENALTY`] per hop so the beam heads for it.
+    hops: Option<std::rc::Rc<Vec<u32>>>,
+    /// Interpolated target `(x, z)` when no body constraint sits here, and the radius around it
+    /// that costs nothing in the ranking (`guide_slack` × distance left to the next target).
+    guide: Option<(f64, f64, f64)>,
+    last: bool,
+}
+
+/// A placed partial path.
+#[derive(Clone)]
+struct State {
+    start: FrameRef,
+    cuts: Vec<EdgeId>,
+    clip: u32,
+    /// Entry frame of the current piece and its output time.
+    a: u32,
+    ta: u32,
+    /// Placement of the current piece.
+    w: Planar,
+    /// Earliest frame the current piece may be left from.
+    min_from: u32,
+    /// Accumulated score terms.
+    acc: f64,
+    /// Accumulated ranking terms (errors beyond the slack).
+    racc: f64,
+}
+
+/// A ranked extension of a beam state to the next checkpoint.
+struct Ext {
+    rank: f64,
+    acc: f64,
+    racc: f64,
+    parent: usize,
+    fill: [EdgeId; 2],
+    n: u8,
+    clip: u32,
+    a: u32,
+    ta: u32,
+    w: Planar,
+    /// Database frame at the checkpoint.
+    frame: u32,
+}
+
+/// Rank added per clip-level hop still needed to reach a clip meeting the next hard constraint.
+const HOP_PENALTY: f64 = 20.0;
+
+/// Clip-level hop counts to `targets` over the top edges (breadth-first on the reversed clip
+/// graph; unreachable clips get `u32::MAX`).
+fn hops_to(g: &MotionGraph, targets: &[u32]) -> Vec<u32> {
+    let n = g.db.clips.len();
+    let mut pred: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for &(a, b) in g.pair_top.keys() {
+        pred[b as usize].push(a);
+    }
+    for p in &mut pred {
+        p.sort_unstable();
+    }
+    let mut d = vec![u32::MAX; n];
+    let mut queue = std::collections::VecDeque::new();
+    for &t in targets {
+        d[t as usize] = 0;
+        queue.push_back(t);
+    }
+    while let Some(c) = queue.pop_front() {
+        for &p in &pred[c as usize] {
+            if d[p as usize] == u32::MAX {
+                d[p as usize] = d[c as usize] + 1;
+                queue.push_back(p);
+            }
+        }
+    }
+    d
+}
+
+/// The checkpoints of a problem, in time order.
+fn checkpoints(g: &MotionGraph, cp: &Compiled, gp: &GuidedParams) -> Vec<Checkpoint> {
+    let last = cp.target.saturating_sub(1);
+    let clamp = |t: u32| t.min(last);
+    let mut times: Vec<u32> = cp
+        .pb
+        .body
+        .iter()
+        .map(|b| clamp(b.time))
+        .chain(cp.pb.joints.iter().map(|j| clamp(j.time)))
+        .chain(cp.hard.iter().map(|h| h.0))
+        .chain(std::iter::once(last))
+        .filter(|&t| t > 0)
+        .collect();
+    times.sort_unstable();
+    times.dedup();
+    let gap = gp.max_gap.max(10);
+    let mut all = Vec::new();
+    let mut prev = 0u32;
+    for &t in &times {
+        let parts = (t - prev).div_ceil(gap);
+        for k in 1..parts {
+            all.push(prev + (t - prev) * k / parts);
+        }
+        all.push(t);
+        prev = t;
+    }
+    let mut body: Vec<(u32, usize)> = cp.pb.body.iter().enumerate().map(|(i, b)| (clamp(b.time), i)).collect();
+    body.sort_unstable();
+    all.into_iter()
+        .map(|t| {
+            let here: Vec<usize> = body.iter().filter(|b| b.0 == t).map(|b| b.1).collect();
+            let guide = if here.is_empty() {
+                let p = body.iter().rev().find(|b| b.0 < t);
+                let n = body.iter().find(|b| b.0 > t);
+                match (p, n) {
+                    (Some(&(tp, ip)), Some(&(tn, inn))) => {
+                        let (bp, bn) = (&cp.pb.body[ip], &cp.pb.body[inn]);
+                        let u = (t - tp) as f64 / (tn - tp) as f64;
+                        let r = gp.guide_slack * (1.0 - u) * (bn.x - bp.x).hypot(bn.z - bp.z);
+                        Some((bp.x + u * (bn.x - bp.x), bp.z + u * (bn.z - bp.z), r))
+                    }
+                    _ => None,
+                }
+            } else {
+                None
+            };
+            Checkpoint {
+                t,
+                body: here,
+                joints: cp.pb.joints.iter().enumerate().filter(|j| clamp(j.1.time) == t).map(|j| j.0).collect(),
+                hard: cp.hard.iter().find(|h| h.0 == t).map(|h| h.1),
+                hard_clips: cp
+                    .hard
+                    .iter()
+                    .find(|h| h.0 == t)
+                    .map(|(_, h)| {
+                        (0..g.db.clips.len() as u32)
+                            .filter(|&c| (0..g.clip_len(c)).any(|f| hard_ok(g, h, FrameRef { clip: c, frame: f })))
+                            .collect()
+                    })
+                    .unwrap_or_default(),
+                hops: None,
+                guide,
+                last: t == last,
+            }
+        })
+        .collect::<Vec<Checkpoint>>()
+        .into_iter()
+        .rev()
+        .scan(None::<std::rc::Rc<Vec<u32>>>, |next_hops, mut c| {
+            // Checkpoints without constraints of their own steer toward the next hard one.
+            if c.body.is_empty() && c.joints.is_empty() && c.hard.is_none() {
+                c.hops = next_hops.clone();
+            }
+            if c.hard.is_some() {
+                *next_hops = Some(std::rc::Rc::new(hops_to(g, &c.hard_clips)));
+            } else if !c.body.is_empty() {
+                *next_hops = None;
+            }
+            Some(c)
+        })
+        .collect::<Vec<Checkpoint>>()
+        .into_iter()
+        .rev()
+        .collect()
+}
+
+/// Beam search context.
+struct Beam<'a> {
+    g: &'a MotionGraph,
+    cp: &'a Compiled,
+    gp: &'a GuidedParams,
+    minp: u32,
+}
+
+impl Beam<'_> {
+    /// Places frame `a + (c.t − ta)` of a piece entered at frame `a`, time `ta`, placement `w`,
+    /// on top of accumulated terms `(acc, racc)` and returns `(acc, racc, rank, frame)`, or `None`
+    /// when the frame is outside the clip, misses the hard constraint or (at the last checkpoint)
+    /// would make the piece shorter than `min_piece`. `jitter` ∈ [0, 1) breaks ties at random.
+    #[allow(clippy::too_many_arguments)]
+    fn eval(
+        &self,
+        c: &Checkpoint,
+        (acc, racc): (f64, f64),
+        clip: u32,
+        a: u32,
+        ta: u32,
+        w: &Planar,
+        jitter: f64,
+    ) -> Option<(f64, f64, f64, u32)> {
+        let f = a + (c.t - ta);
+        if f >= self.g.clip_len(clip) || (c.last && f + 1 < a + self.minp) {
+            return None;
+        }
+        let fr = FrameRef { clip, frame: f };
+        if let Some(h) = &c.hard {
+            if !hard_ok(self.g, h, fr) {
+                return None;
+            }
+        }
+        let feat = &self.g.features;
+        let wt = w.compose(&feat.torso(clip, f));
+        let (mut acc, mut racc) = (acc, racc);
+        let (sp, sy) = if c.last { (0.0, 0.0) } else { (self.gp.slack_m, self.gp.slack_deg.to_radians()) };
+        for &i in &c.body {
+            let b = &self.cp.pb.body[i];
+            let e = (wt.x - b.x).hypot(wt.z - b.z);
+            let dy = b.yaw.map_or(0.0, |y| wrap_angle(wt.yaw - y).abs());
+            acc += self.cp.w_p * e * e + self.cp.w_o * dy * dy;
+            racc += self.cp.w_p * (e - sp).max(0.0).powi(2) + self.cp.w_o * (dy - sy).max(0.0).powi(2);
+        }
+        for &i in &c.joints {
+            let j = &self.cp.pb.joints[i];
+            let x = wt.apply_point(feat.local(clip, f, j.joint as usize));
+            let e = (x - j.pos).norm();
+            acc += self.cp.w_j * e * e;
+            racc += self.cp.w_j * (e - sp).max(0.0).powi(2);
+        }
+        let mut guide = c.guide.map_or(0.0, |(x, z, r)| {
+            self.gp.guide_weight * self.cp.w_p * ((wt.x - x).hypot(wt.z - z) - r).max(0.0).powi(2)
+        });
+        if let Some(h) = &c.hops {
+            guide += HOP_PENALTY * h[clip as usize].min(1000) as f64;
+        }
+        Some((acc, racc, racc + guide + 1e-6 * jitter, f))
+    }
+
+    /// Range `[lo, hi)` of `out_leaf[clip]` leaving at frames `from ≤ i ≤ to`.
+    fn leaves(&self, clip: u32, from: u32, to: u32) -> (usize, usize) {
+        let outs = &self.g.out_leaf[clip as usize];
+        let fr = |e: &EdgeId| self.g.edges[*e as usize].from.frame;
+        let lo = outs.partition_point(|e| fr(e) < from);
+        (lo, outs.partition_point(|e| fr(e) <= to).max(lo))
+    }
+
+    /// The piece entered through edge `e` from a piece `(clip, a, ta, w)`: `(clip, a, ta, w)`.
+    fn follow(&self, e: EdgeId, a: u32, ta: u32, w: &Planar) -> (u32, u32, u32, Planar) {
+        let n = &self.g.edges[e as usize];
+        let f = &self.g.features;
+        let w2 = w.compose(&f.torso(n.from.clip, n.from.frame + 1)).compose(&f.torso(n.to.clip, n.to.frame).inverse());
+        (n.to.clip, n.to.frame, ta + (n.from.frame - a) + 1, w2)
+    }
+
+    /// All ranked extensions of state `si` to checkpoint `c`.
+    fn extend(&self, si: usize, s: &State, c: &Checkpoint, rng: &mut Rng, out: &mut Vec<Ext>) {
+        let g = self.g;
+        let cost = |e: EdgeId| self.cp.pb.weights.cut * g.edges[e as usize].cost as f64;
+        let plus = |x: f64| (s.acc + x, s.racc + x);
+        // 0 cuts: stay in the piece.
+        if let Some((acc, racc, rank, frame)) = self.eval(c, plus(0.0), s.clip, s.a, s.ta, &s.w, rng.f64()) {
+            out.push(Ext {
+                rank,
+                acc,
+                racc,
+                parent: si,
+                fill: [0; 2],
+                n: 0,
+                clip: s.clip,
+                a: s.a,
+                ta: s.ta,
+                w: s.w,
+                frame,
+            });
+        }
+        // Leaving at frame i plays the entered frame at ta + i − a + 1 ≤ t_c.
+        let Some(hi) = (s.a + (c.t - s.ta)).checked_sub(1) else { return };
+        let (lo1, hi1) = self.leaves(s.clip, s.min_from, hi);
+        let outs = &g.out_leaf[s.clip as usize];
+        // 1 cut: every leaf edge.
+        for &e in &outs[lo1..hi1] {
+            let (clip, a, ta, w) = self.follow(e, s.a, s.ta, &s.w);
+            if let Some((acc, racc, rank, frame)) = self.eval(c, plus(cost(e)), clip, a, ta, &w, rng.f64()) {
+                out.push(Ext { rank, acc, racc, parent: si, fill: [e, 0], n: 1, clip, a, ta, w, frame });
+            }
+        }
+        // At a hard constraint: every first edge, then every top edge into a clip that holds a
+        // matching frame (one-hop landing of §3.7, exhaustive over the first edge).
+        if c.hard.is_some() {
+            for &e1 in &outs[lo1..hi1] {
+                let (c1, a1, t1, w1) = self.follow(e1, s.a, s.ta, &s.w);
+                if t1 >= c.t {
+                    continue;
+                }
+                let hi2 = a1 + (c.t - t1) - 1;
+                for &l in &c.hard_clips {
+                    let Some(es) = g.pair_top.get(&(c1, l)) else { continue };
+                    let fr = |e: &EdgeId| g.edges[*e as usize].from.frame;
+                    let lo = es.partition_point(|e| fr(e) < a1 + self.minp - 1);
+                    for &e2 in es[lo..].iter().take_while(|e| fr(e) <= hi2) {
+                        let (clip, a, ta, w) = self.follow(e2, a1, t1, &w1);
+                        let jit = rng.f64();
+                        if let Some((acc, racc, rank, frame)) =
+                            self.eval(c, plus(cost(e1) + cost(e2)), clip, a, ta, &w, jit)
+                        {
+                            out.push(Ext { rank, acc, racc, parent: si, fill: [e1, e2], n: 2, clip, a, ta, w, frame });
+                        }
+                    }
+                }
+            }
+        }
+        // 2 cuts: drawn first edges, then drawn (or, at a hard constraint, all) second edges.
+        let avail = hi1 - lo1;
+        for _ in 0..self.gp.first_draws.min(avail) {
+            let e1 = outs[lo1 + rng.below(avail)];
+            let (c1, a1, t1, w1) = self.follow(e1, s.a, s.ta, &s.w);
+            if t1 >= c.t {
+                continue;
+            }
+            let Some(hi2) = (a1 + (c.t - t1)).checked_sub(1) else { continue };
+            let (lo2, hi2) = self.leaves(c1, a1 + self.minp - 1, hi2);
+            let outs2 = &g.out_leaf[c1 as usize];
+            let n2 = hi2 - lo2;
+            if n2 == 0 {
+                continue;
+            }
+            let take = |e2: EdgeId, out: &mut Vec<Ext>, jitter: f64| {
+                let (clip, a, ta, w) = self.follow(e2, a1, t1, &w1);
+                if let Some((acc, racc, rank, frame)) = self.eval(c, plus(cost(e1) + cost(e2)), clip, a, ta, &w, jitter)
+                {
+                    out.push(Ext { rank, acc, racc, parent: si, fill: [e1, e2], n: 2, clip, a, ta, w, frame });
+                }
+            };
+            if c.hard.is_some() {
+                for &e2 in &outs2[lo2..hi2] {
+                    take(e2, out, rng.f64());
+                }
+            } else {
+                for _ in 0..self.gp.second_draws.min(n2) {
+                    let e2 = outs2[lo2 + rng.below(n2)];
+                    take(e2, out, rng.f64());
+                }
+            }
+        }
+    }
+}
+
+/// Up to `gp.width` guided seed paths for `cp`, best first; `Err(reason)` when no state reaches
+/// some checkpoint (e.g. a hard constraint outside every reachable clip).
+pub(crate) fn guided_seeds(
+    g: &MotionGraph,
+    cp: &Compiled,
+    gp: &GuidedParams,
+    min_piece: u32,
+    rng: &mut Rng,
+) -> std::result::Result<Vec<Scored>, String> {
+    let minp = min_piece.max(1);
+    let width = gp.width;
+    if width == 0 || g.db.clips.is_empty() {
+        return Ok(Vec::new());
+    }
+    // Start states: the time-0 hard constraint's frames, or random frames.
+    let starts: Vec<FrameRef> = match cp.hard.first() {
+        Some((0, h)) => {
+            let all: Vec<FrameRef> = (0..g.db.clips.len() as u32)
+                .flat_map(|c| (0..g.clip_len(c)).map(move |f| FrameRef { clip: c, frame: f }))
+                .filter(|f| hard_ok(g, h, *f))
+                .collect();
+            if all.is_empty() {
+                return Err("no frame meets the time-0 hard constraint".into());
+            }
+            (0..width * gp.start_factor.max(1)).map(|_| all[rng.below(all.len())]).collect()
+        }
+        _ => {
+            let long: Vec<u32> = (0..g.db.clips.len() as u32).filter(|&c| g.clip_len(c) >= minp).collect();
+            if long.is_empty() {
+                return Err("every clip is shorter than a piece".into());
+            }
+            (0..width * gp.start_factor.max(1))
+                .map(|_| {
+                    let c = long[rng.below(long.len())];
+                    FrameRef { clip: c, frame: rng.below((g.clip_len(c) - minp + 1) as usize) as u32 }
+                })
+                .collect()
+        }
+    };
+    let mut beam: Vec<State> = starts
+        .into_iter()
+        .map(|s| State {
+            start: s,
+            cuts: Vec::new(),
+            clip: s.clip,
+            a: s.frame,
+            ta: 0,
+            w: cp.start.compose(&g.features.torso(s.clip, s.frame).inverse()),
+            min_from: s.frame + minp - 1,
+            acc: 0.0,
+            racc: 0.0,
+        })
+        .collect();
+    let ctx = Beam { g, cp, gp, minp };
+    let mut exts = Vec::new();
+    for c in checkpoints(g, cp, gp) {
+        exts.clear();
+        for (si, s) in beam.iter().enumerate() {
+            ctx.extend(si, s, &c, rng, &mut exts);
+        }
+        if exts.is_empty() {
+            return Err(format!("guided seeds: no path reaches frame {}", c.t));
+        }
+        exts.sort_by(|x, y| x.rank.total_cmp(&y.rank));
+        let mut seen = HashSet::new();
+        let mut children = vec![0usize; beam.len()];
+        let mut next = Vec::with_capacity(width);
+        for x in &exts {
+            if next.len() == width {
+                break;
+            }
+            if children[x.parent] >= gp.per_parent.max(1) || !seen.insert((x.clip, x.frame)) {
+                continue;
+            }
+            children[x.parent] += 1;
+            let p = &beam[x.parent];
+            let mut cuts = p.cuts.clone();
+            cuts.extend_from_slice(&x.fill[..x.n as usize]);
+            let min_from = if x.n == 0 { p.min_from.max(x.frame) } else { (x.a + minp - 1).max(x.frame) };
+            next.push(State {
+                start: p.start,
+                cuts,
+                clip: x.clip,
+                a: x.a,
+                ta: x.ta,
+                w: x.w,
+                min_from,
+                acc: x.acc,
+                racc: x.racc,
+            });
+        }
+        beam = next;
+    }
+    let mut out: Vec<Scored> = beam
+        .into_iter()
+        .filter_map(|s| {
+            let end_frame = s.a + (cp.target - 1 - s.ta);
+            score(g, cp, &Path { start: s.start, cuts: s.cuts, end_frame }, minp)
+        })
+        .collect();
+    out.sort_by(|a, b| a.score.total_cmp(&b.score));
+    Ok(out)
+}

@@ -1,0 +1,404 @@
+//! flip-tet's core scenes (spec §6): `rest-pool` (S1), `dam-break` (S2, Martin & Moyce 1952),
+//! `standing-wave` (S3, linear theory), `drop-pool` (S4), `holes-plate` (S7) and
+//! `adaptivity-payoff` (S10). Each writes `metrics.csv` (one row per step, with the per-stage
+//! timings remesh / transfer / solve / advect / surface), OBJ surfaces per frame under `frames/`,
+//! PNG plots and the summary keys of issue 5.
+
+use std::path::Path;
+use std::time::Instant;
+
+use flip_tet::metrics::{self, CSV_HEADER};
+use flip_tet::scene::{Scene, Shape};
+use flip_tet::sim::{FlipTetSim, StepStats};
+use geom_core::io::{write_obj_frame, MeshOut};
+use serde::Deserialize;
+
+use crate::error::{Error, Result};
+use crate::out::{Cell, CsvWriter, Summary};
+use crate::plot::{LinePlot, Series};
+use crate::registry::{RunCtx, Runner};
+use crate::scene;
+
+/// Adds flip-tet's core runners.
+pub fn register(v: &mut Vec<Runner>) {
+    v.push(Runner { method: "flip-tet/rest-pool", run: run_rest_pool });
+    v.push(Runner { method: "flip-tet/dam-break", run: run_dam_break });
+    v.push(Runner { method: "flip-tet/standing-wave", run: run_standing_wave });
+    v.push(Runner { method: "flip-tet/drop-pool", run: run_drop_pool });
+    v.push(Runner { method: "flip-tet/holes-plate", run: run_drop_pool });
+    v.push(Runner { method: "flip-tet/adaptivity-payoff", run: run_adaptivity });
+}
+
+fn ft<T>(r: flip_tet::error::Result<T>) -> Result<T> {
+    r.map_err(|e| Error::Run(format!("flip-tet: {e}")))
+}
+
+/// Parameters shared by the core scenes: the simulator scene plus per-mode sizes.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FtParams {
+    /// The flip-tet scene (its `resolution.finest` and `duration` are replaced per mode).
+    pub scene: Scene,
+    /// Finest resolution for (quick, default, full).
+    pub finest: (u32, u32, u32),
+    /// Coarsest resolution for (quick, default, full); `None` keeps the scene's.
+    #[serde(default)]
+    pub coarsest: Option<(u32, u32, u32)>,
+    /// Duration (s) for (quick, default, full).
+    pub duration: (f64, f64, f64),
+    /// Write the simulation surface as OBJ every `obj_every` frames (0 = never).
+    #[serde(default = "one")]
+    pub obj_every: u64,
+    /// adaptivity-payoff: finest resolutions compared for (quick, default, full).
+    #[serde(default)]
+    pub sizes: Option<(Vec<u32>, Vec<u32>, Vec<u32>)>,
+}
+
+fn one() -> u64 {
+    1
+}
+
+pub(crate) fn load_file(path: &Path, mode: scene::Mode) -> Result<(FtParams, Scene)> {
+    let f = scene::load::<FtParams>(path)?;
+    let p = f.params;
+    let mut s = p.scene.clone();
+    s.resolution.finest = mode.pick(p.finest.0, p.finest.1, p.finest.2);
+    if let Some(c) = p.coarsest {
+        s.resolution.coarsest = mode.pick(c.0, c.1, c.2);
+    }
+    s.duration = mode.pick(p.duration.0, p.duration.1, p.duration.2);
+    Ok((p, s))
+}
+
+fn load(ctx: &RunCtx) -> Result<(FtParams, Scene)> {
+    load_file(&ctx.scene_file, ctx.mode)
+}
+
+/// Runs a scene to its duration, writing `metrics.csv` every step and OBJ frames, calling `probe`
+/// after every step. Returns the step statistics and the wall time.
+pub(crate) fn simulate(
+    scene: &Scene,
+    out: &Path,
+    obj_every: u64,
+    probe: &mut dyn FnMut(&FlipTetSim, &StepStats),
+) -> Result<(Vec<StepStats>, f64, FlipTetSim)> {
+    let t0 = Instant::now();
+    let mut sim = ft(FlipTetSim::new(scene))?;
+    let mut csv = CsvWriter::create(&out.join("metrics.csv"), &CSV_HEADER)?;
+    let mut all = Vec::new();
+    let mut frame = 0u64;
+    let write_frame = |sim: &FlipTetSim, frame: u64| -> Result<()> {
+        if obj_every > 0 && frame.is_multiple_of(obj_every) {
+            if let Some(m) = sim.surface() {
+                write_obj_frame(&out.join("frames"), (frame / obj_every) as usize, &MeshOut::from_tri_mesh(&m))?;
+            }
+        }
+        Ok(())
+    };
+    write_frame(&sim, 0)?;
+    while sim.time() < scene.duration - 1e-9 {
+        let st = ft(sim.step())?;
+        csv.row(&metrics::csv_row(&st).into_iter().map(Cell::Num).collect::<Vec<_>>())?;
+        probe(&sim, &st);
+        if st.frame_end {
+            frame += 1;
+            write_frame(&sim, frame)?;
+        }
+        all.push(st);
+    }
+    Ok((all, t0.elapsed().as_secs_f64(), sim))
+}
+
+fn common(s: &mut Summary, stats: &[StepStats], wall: f64) {
+    let steps = stats.len().max(1) as f64;
+    let psteps: f64 = stats.iter().map(|x| x.n_particles as f64).sum();
+    s.set("wall_s", wall);
+    s.set_count("steps", stats.len() as u64);
+    s.set("particles_avg", psteps / steps);
+    s.set("us_per_particle_step", 1e6 * wall / psteps.max(1.0));
+    let mut st = [0.0; 5];
+    for x in stats {
+        for (a, b) in st.iter_mut().zip(x.timings.stages()) {
+            *a += b;
+        }
+    }
+    for (k, v) in ["remesh", "transfer", "solve", "advect", "surface"].iter().zip(st) {
+        s.set(&format!("time_{k}_s"), v);
+    }
+    s.set_str("profile", if cfg!(debug_assertions) { "debug" } else { "release" });
+}
+
+fn rel_drift(stats: &[StepStats], f: impl Fn(&StepStats) -> f64) -> f64 {
+    let Some(first) = stats.first() else { return 0.0 };
+    let v0 = f(first);
+    stats.iter().map(|x| (f(x) - v0).abs()).fold(0.0, f64::max) / v0.abs().max(1e-300)
+}
+
+fn run_rest_pool(ctx: &RunCtx) -> Result<Summary> {
+    let (p, scene) = load(ctx)?;
+    let x0 = ft(FlipTetSim::new(&scene))?.particles().x.clone();
+    let mut disp: f64 = 0.0;
+    let (stats, wall, _) = simulate(&scene, &ctx.out_dir, p.obj_every, &mut |sim, _| {
+        if sim.particles().len() == x0.len() {
+            let d = sim.particles().x.iter().zip(&x0).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+            disp = disp.max(d);
+        }
+    })?;
+    let mut s = Summary::new();
+    s.set("max_speed", stats.iter().map(|x| x.max_speed).fold(0.0, f64::max));
+    s.set("volume_drift_rel", rel_drift(&stats, |x| x.vol_levelset));
+    s.set("particle_volume_drift_rel", rel_drift(&stats, |x| x.vol_particles));
+    s.set("max_displacement", disp);
+    s.set_count("splits_merges", stats.iter().map(|x| (x.n_split + x.n_merge) as u64).sum());
+    common(&mut s, &stats, wall);
+    let pts: Vec<(f64, f64)> = stats.iter().map(|x| (x.step as f64, x.max_speed.max(1e-20))).collect();
+    LinePlot::new("rest pool: max particle speed", "step", "max speed (m/s)")
+        .log(false, true)
+        .with(Series::new("second order, direct", pts))
+        .write_png(&ctx.out_dir.join("speed_vs_step.png"))?;
+    Ok(s)
+}
+
+fn run_dam_break(ctx: &RunCtx) -> Result<Summary> {
+    let (p, scene) = load(ctx)?;
+    // Column width a: the liquid box's x extent from the wall x = min.
+    let a = match scene.liquid.first() {
+        Some(Shape::Box { min, max }) => max[0] - min[0],
+        _ => return Err(Error::Run("dam-break: the first liquid shape must be the column Box".into())),
+    };
+    let (wall, floor) = (scene.domain.min[0], scene.domain.min[1]);
+    let g = -scene.gravity[1];
+    let mut front: Vec<(f64, f64)> = Vec::new();
+    let mut height: Vec<(f64, f64)> = Vec::new();
+    let (stats, wall_s, _) = simulate(&scene, &ctx.out_dir, p.obj_every, &mut |sim, st| {
+        let parts = sim.particles();
+        front.push((st.t * (2.0 * g / a).sqrt(), metrics::front_position(parts, wall) / a));
+        height.push((st.t * (g / a).sqrt(), metrics::column_height(parts, wall, a / 8.0, floor) / (2.0 * a)));
+    })?;
+    let (errs, rms) = front_errors(&front);
+    let mut csv = CsvWriter::create(&ctx.out_dir.join("front_vs_mm.csv"), &["T", "Z_exp", "Z_sim", "rel_err"])?;
+    for (&(t, z), e) in metrics::MARTIN_MOYCE_FRONT.iter().zip(&errs) {
+        csv.row(&[Cell::Num(t), Cell::Num(z), Cell::Num(z * (1.0 + e)), Cell::Num(*e)])?;
+    }
+    let mut herr: f64 = 0.0;
+    let tau_end = height.last().map_or(0.0, |x| x.0);
+    for &(tau, h) in metrics::MARTIN_MOYCE_HEIGHT.iter().filter(|x| x.0 <= tau_end.min(2.5)) {
+        herr = herr.max((metrics::interp(&height, tau) - h).abs());
+    }
+    // Late slope dZ/dT by least squares over T ∈ [2.5, 3.33].
+    let late: Vec<(f64, f64)> = front.iter().copied().filter(|x| x.0 >= 2.5 && x.0 <= 3.33).collect();
+    let slope = if late.len() > 2 {
+        let n = late.len() as f64;
+        let (mx, my) = (late.iter().map(|x| x.0).sum::<f64>() / n, late.iter().map(|x| x.1).sum::<f64>() / n);
+        let sxy: f64 = late.iter().map(|x| (x.0 - mx) * (x.1 - my)).sum();
+        let sxx: f64 = late.iter().map(|x| (x.0 - mx).powi(2)).sum();
+        sxy / sxx
+    } else {
+        f64::NAN
+    };
+    let mut s = Summary::new();
+    s.set("front_rms_rel_err", rms);
+    s.set("front_max_rel_err", errs.iter().map(|e| e.abs()).fold(0.0, f64::max));
+    s.set_count("front_points_compared", errs.len() as u64);
+    s.set("height_max_abs_err_tau_le_2_5", herr);
+    s.set("late_slope_dZdT", slope);
+    s.set("vol_particles_drift_rel", rel_drift(&stats, |x| x.vol_particles));
+    s.set("vol_levelset_drift_rel", rel_drift(&stats, |x| x.vol_levelset));
+    s.set("column_width_a_m", a);
+    s.set_str("time_scaling", "T = t*sqrt(2g/a) (front), tau = t*sqrt(g/a) (height), a = column width");
+    common(&mut s, &stats, wall_s);
+    LinePlot::new("dam break: surge front vs Martin & Moyce (1952)", "T = t sqrt(2g/a)", "Z = x/a")
+        .with(Series::new("simulation", front.clone()))
+        .with(Series::new("Martin & Moyce 1952", metrics::MARTIN_MOYCE_FRONT.to_vec()))
+        .write_png(&ctx.out_dir.join("front_vs_mm.png"))?;
+    LinePlot::new("dam break: residual column height", "tau = t sqrt(g/a)", "H = h/(2a)")
+        .with(Series::new("simulation", height))
+        .with(Series::new("Martin & Moyce 1952", metrics::MARTIN_MOYCE_HEIGHT.to_vec()))
+        .write_png(&ctx.out_dir.join("height_vs_mm.png"))?;
+    Ok(s)
+}
+
+/// Relative front errors `(Z_sim − Z_exp)/Z_exp` at the tabulated Martin & Moyce times covered by
+/// the simulated series `(T, Z)`, and their RMS.
+pub(crate) fn front_errors(front: &[(f64, f64)]) -> (Vec<f64>, f64) {
+    let t_end = front.last().map_or(0.0, |x| x.0);
+    let errs: Vec<f64> = metrics::MARTIN_MOYCE_FRONT
+        .iter()
+        .filter(|x| x.0 <= t_end)
+        .map(|&(t, z)| (metrics::interp(front, t) - z) / z)
+        .collect();
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64).sqrt();
+    (errs, rms)
+}
+
+fn run_standing_wave(ctx: &RunCtx) -> Result<Summary> {
+    let (p, scene) = load(ctx)?;
+    let (mean, amp, len, x0) = match scene.liquid.first() {
+        Some(Shape::CosineSurface { mean, amplitude, length, x0 }) => (*mean, *amplitude, *length, *x0),
+        _ => return Err(Error::Run("standing-wave: the liquid must be a CosineSurface".into())),
+    };
+    let depth = mean - scene.domain.min[1];
+    let g = -scene.gravity[1];
+    let k = std::f64::consts::PI / len;
+    let omega = (g * k * (k * depth).tanh()).sqrt();
+    let t_th = 2.0 * std::f64::consts::PI / omega;
+    let zc = 0.5 * (scene.domain.min[2] + scene.domain.max[2]);
+    let mut eta: Vec<(f64, f64)> = Vec::new();
+    let mut xp = x0;
+    let (stats, wall, _) = simulate(&scene, &ctx.out_dir, p.obj_every, &mut |sim, st| {
+        xp = x0 + sim.spec().h_min() / 2.0;
+        if let Some(h) = metrics::surface_height(sim, xp, zc) {
+            eta.push((st.t, h));
+        }
+    })?;
+    let period = metrics::zero_crossing_period(&eta, 0.5 * t_th);
+    let mut s = Summary::new();
+    s.set("period_theory_s", t_th);
+    s.set("period_sim_s", period.unwrap_or(f64::NAN));
+    s.set("period_rel_err", period.map_or(f64::NAN, |p| (p - t_th).abs() / t_th));
+    s.set("amplitude_initial_m", amp);
+    let theory: Vec<(f64, f64)> = eta
+        .iter()
+        .map(|&(t, _)| (t, mean + amp * (std::f64::consts::PI * (xp - x0) / len).cos() * (omega * t).cos()))
+        .collect();
+    common(&mut s, &stats, wall);
+    LinePlot::new("standing wave: surface height at the wall", "t (s)", "eta (m)")
+        .with(Series::new("simulation", eta))
+        .with(Series::new("linear theory", theory))
+        .write_png(&ctx.out_dir.join("eta_vs_time.png"))?;
+    Ok(s)
+}
+
+/// Liquid volume of the scene's initial shapes estimated by sampling on a fine grid (m³).
+fn initial_liquid_volume(scene: &Scene, n: usize) -> f64 {
+    let (mn, mx) = (scene.min(), scene.max());
+    let d = (mx - mn) / n as f64;
+    let mut c = 0usize;
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let x = mn
+                    + geom_core::math::Vec3::new(
+                        (i as f64 + 0.5) * d.x,
+                        (j as f64 + 0.5) * d.y,
+                        (k as f64 + 0.5) * d.z,
+                    );
+                if scene.liquid_sdf(&x) < 0.0 && scene.solid_sdf(&x) > 0.0 {
+                    c += 1;
+                }
+            }
+        }
+    }
+    c as f64 * d.x * d.y * d.z
+}
+
+fn run_drop_pool(ctx: &RunCtx) -> Result<Summary> {
+    let (p, scene) = load(ctx)?;
+    let (stats, wall, _) = simulate(&scene, &ctx.out_dir, p.obj_every, &mut |_, _| {})?;
+    let n0 = stats.first().map_or(0, |x| x.n_particles) as f64;
+    let peak = stats.iter().map(|x| x.n_particles).max().unwrap_or(0) as f64;
+    let end = stats.last().map_or(0, |x| x.n_particles) as f64;
+    let h_min = (0..3).map(|a| scene.domain.max[a] - scene.domain.min[a]).fold(0.0, f64::max)
+        / f64::from(scene.resolution.finest);
+    let uniform = 8.0 * initial_liquid_volume(&scene, 128) / h_min.powi(3);
+    let ballistic: f64 = stats.iter().map(|x| x.n_ballistic as f64 / x.n_particles.max(1) as f64).sum::<f64>()
+        / stats.len().max(1) as f64;
+    // Pearson correlation of per-step wall time (remesh excluded) with particle count.
+    let xs: Vec<f64> = stats.iter().map(|x| x.n_particles as f64).collect();
+    let ys: Vec<f64> = stats.iter().map(|x| x.timings.total() - x.timings.remesh).collect();
+    let n = xs.len().max(1) as f64;
+    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+    let cov: f64 = xs.iter().zip(&ys).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let (vx, vy) = (xs.iter().map(|a| (a - mx).powi(2)).sum::<f64>(), ys.iter().map(|b| (b - my).powi(2)).sum::<f64>());
+    let mut s = Summary::new();
+    s.set("particles_initial", n0);
+    s.set("particles_peak", peak);
+    s.set("particles_end", end);
+    s.set("peak_over_initial", peak / n0.max(1.0));
+    s.set("end_over_initial", end / n0.max(1.0));
+    s.set("uniform_particles_estimate", uniform);
+    s.set("uniform_over_adaptive_initial", uniform / n0.max(1.0));
+    s.set("ballistic_fraction_avg", ballistic);
+    s.set("time_particles_pearson", if vx > 0.0 && vy > 0.0 { cov / (vx * vy).sqrt() } else { f64::NAN });
+    s.set("vol_levelset_drift_rel", rel_drift(&stats, |x| x.vol_levelset));
+    common(&mut s, &stats, wall);
+    let pts: Vec<(f64, f64)> = stats.iter().map(|x| (x.t, x.n_particles as f64)).collect();
+    LinePlot::new("particles vs time", "t (s)", "particles")
+        .with(Series::new("adaptive", pts))
+        .write_png(&ctx.out_dir.join("particles_vs_time.png"))?;
+    Ok(s)
+}
+
+fn run_adaptivity(ctx: &RunCtx) -> Result<Summary> {
+    let (p, base) = load(ctx)?;
+    let sizes = p.sizes.clone().ok_or_else(|| Error::Run("adaptivity-payoff: `sizes` is required".into()))?;
+    let list = ctx.mode.pick(sizes.0, sizes.1, sizes.2);
+    let mut csv = CsvWriter::create(
+        &ctx.out_dir.join("cost_vs_n.csv"),
+        &["finest", "variant", "particle_steps", "particles_avg", "wall_s", "steps"],
+    )?;
+    let mut s = Summary::new();
+    let mut cost = (Vec::new(), Vec::new());
+    let mut parts = (Vec::new(), Vec::new());
+    let mut last = (0.0, 0.0, 0.0, 0.0);
+    for &n in &list {
+        for adaptive in [true, false] {
+            let mut sc = base.clone();
+            sc.resolution.finest = n;
+            if !adaptive {
+                sc.resolution.coarsest = n;
+            }
+            let dir = ctx.out_dir.join(format!("{}_{n}", if adaptive { "adaptive" } else { "uniform" }));
+            crate::out::ensure_dir(&dir)?;
+            let (stats, wall, _) = simulate(&sc, &dir, 0, &mut |_, _| {})?;
+            let ps: f64 = stats.iter().map(|x| x.n_particles as f64).sum();
+            let avg = ps / stats.len().max(1) as f64;
+            csv.row(&[
+                Cell::Int(i64::from(n)),
+                Cell::Text(if adaptive { "adaptive" } else { "uniform" }.into()),
+                Cell::Num(ps),
+                Cell::Num(avg),
+                Cell::Num(wall),
+                Cell::Int(stats.len() as i64),
+            ])?;
+            let sim_t = stats.last().map_or(1.0, |x| x.t).max(1e-9);
+            if adaptive {
+                cost.0.push((f64::from(n), wall / sim_t));
+                parts.0.push((f64::from(n), avg));
+                last.0 = avg;
+                last.2 = wall;
+            } else {
+                cost.1.push((f64::from(n), wall / sim_t));
+                parts.1.push((f64::from(n), avg));
+                last.1 = avg;
+                last.3 = wall;
+            }
+        }
+    }
+    s.set("finest_compared", f64::from(*list.last().unwrap_or(&0)));
+    s.set("particle_ratio_adaptive_over_uniform", last.0 / last.1.max(1.0));
+    s.set("time_ratio_adaptive_over_uniform", last.2 / last.3.max(1e-12));
+    s.set_str("profile", if cfg!(debug_assertions) { "debug" } else { "release" });
+    let beta = |v: &Vec<(f64, f64)>| {
+        if v.len() >= 2 {
+            (v[v.len() - 1].1 / v[0].1).ln() / (v[v.len() - 1].0 / v[0].0).ln()
+        } else {
+            f64::NAN
+        }
+    };
+    s.set("beta_particles_adaptive", beta(&parts.0));
+    s.set("beta_particles_uniform", beta(&parts.1));
+    s.set("alpha_cost_adaptive", beta(&cost.0));
+    s.set("alpha_cost_uniform", beta(&cost.1));
+    LinePlot::new("cost vs finest resolution", "N", "wall s per simulated s")
+        .log(true, true)
+        .with(Series::new("adaptive", cost.0))
+        .with(Series::new("uniform", cost.1))
+        .write_png(&ctx.out_dir.join("cost_vs_N.png"))?;
+    LinePlot::new("particles vs finest resolution", "N", "particles (avg)")
+        .log(true, true)
+        .with(Series::new("adaptive", parts.0))
+        .with(Series::new("uniform", parts.1))
+        .write_png(&ctx.out_dir.join("particles_vs_N.png"))?;
+    Ok(s)
+}
