@@ -29,7 +29,7 @@ use rigging::{autorig, prepare_embedding, Hint, Rig, RigError, RigOptions, Skele
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
-use crate::out::{CsvWriter, Summary};
+use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
 use crate::registry::{RunCtx, Runner};
 use crate::scene;
@@ -174,7 +174,7 @@ pub fn run_test16(ctx: &RunCtx) -> Result<Summary> {
             worst = s.worst_reduced;
             let t = &rig.timings;
             totals.push(t.total());
-            csv.row(&[
+            let mut cells: Vec<Cell> = vec![
                 (seed as usize).into(),
                 test_class(seed).into(),
                 mesh.n_vertices().into(),
@@ -182,22 +182,17 @@ pub fn run_test16(ctx: &RunCtx) -> Result<Summary> {
                 reason.as_str().into(),
                 (100.0 * s.mean_err_rel).into(),
                 (100.0 * s.max_err_rel).into(),
-                t.normalize.into(),
-                t.distance_field.into(),
-                t.medial.into(),
-                t.packing.into(),
-                t.graph.into(),
-                t.discrete.into(),
-                t.refine.into(),
-                t.attach.into(),
-                t.total().into(),
+            ];
+            cells.extend(timing_cells(t));
+            cells.extend([
                 rig.discrete.expanded.into(),
                 (rig.discrete.certified_optimal as usize).into(),
                 rig.diagnostics.spheres.into(),
                 mw.into(),
                 se.into(),
                 re.into(),
-            ])?;
+            ]);
+            csv.row(&cells)?;
             if p.write_meshes {
                 let dir = ctx.out_dir.join("meshes");
                 crate::out::ensure_dir(&dir)?;
@@ -313,20 +308,9 @@ pub fn run_timing(ctx: &RunCtx) -> Result<Summary> {
             let rig = rg(autorig(&mesh.positions, &mesh.faces, &sk, &[], &o))?;
             let t = rig.timings;
             let n = mesh.n_vertices();
-            csv.row(&[
-                (seed as usize).into(),
-                nv.into(),
-                n.into(),
-                t.normalize.into(),
-                t.distance_field.into(),
-                t.medial.into(),
-                t.packing.into(),
-                t.graph.into(),
-                t.discrete.into(),
-                t.refine.into(),
-                t.attach.into(),
-                t.total().into(),
-            ])?;
+            let mut cells: Vec<Cell> = vec![(seed as usize).into(), nv.into(), n.into()];
+            cells.extend(timing_cells(&t));
+            csv.row(&cells)?;
             let vals = [t.distance_field, t.medial, t.graph, t.discrete, t.refine, t.attach, t.total()];
             for (k, v) in vals.iter().enumerate() {
                 series[k].push((n as f64, v.max(1e-6)));
@@ -840,4 +824,20 @@ pub fn run_weights_vs_proximity(ctx: &RunCtx) -> Result<Summary> {
         .set_count("torso_arm_heat", bad_heat as u64)
         .set_count("torso_arm_proximity", bad_prox as u64);
     Ok(s)
+}
+
+/// The per-stage timing columns (s) of a rig, in the order of the CSV headers:
+/// normalize, distance field, medial, packing, graph, discrete, refine, attach, total.
+fn timing_cells(t: &rigging::StageTimings) -> [Cell; 9] {
+    [
+        t.normalize.into(),
+        t.distance_field.into(),
+        t.medial.into(),
+        t.packing.into(),
+        t.graph.into(),
+        t.discrete.into(),
+        t.refine.into(),
+        t.attach.into(),
+        t.total().into(),
+    ]
 }
