@@ -8,13 +8,14 @@
 //! follows the guide.
 //!
 //! Modules: [`guide`] (guide trajectories), [`testfn`] and [`cluster`] (test-function designs),
-//! [`constraints`] (𝓜, C̄, C, eq. 8, rank), [`kkt`] (the saddle-point solvers), [`tracker`] (the
+//! [`constraints`] (𝓜, C̄, C, eq. 8, rank), [`kkt`] (the saddle-point solvers) and [`augmented`] (the augmented-Lagrangian one), [`tracker`] (the
 //! constrained step, initial projection, residuals), [`metrics`] (deviation, wavelength, tug
 //! index, …) and [`procedural`] (the guides of the paper's scenes).
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![allow(clippy::needless_range_loop)]
 
+pub mod augmented;
 pub mod cluster;
 pub mod constraints;
 pub mod error;

@@ -65,6 +65,7 @@ fn residual_every_step() {
         KktMethod::InterleavedLdlt,
         KktMethod::AmdRegularizedLdlt { delta: 1e-8 },
         KktMethod::Schur,
+        KktMethod::AugmentedLagrangian { alpha: 1e6 },
     ] {
         let (mut tr, l) = tracker(m, 2);
         assert!(tr.residual_now() <= 1e-12 * l, "initial state consistent");
@@ -85,6 +86,7 @@ fn kkt_methods_agree() {
         KktMethod::InterleavedLdlt,
         KktMethod::AmdRegularizedLdlt { delta: 1e-8 },
         KktMethod::Schur,
+        KktMethod::AugmentedLagrangian { alpha: 1e6 },
     ] {
         let (mut tr, _) = tracker(m, 2);
         for _ in 0..5 {

@@ -1448,5 +1448,6 @@ fn method_key(m: &KktMethod) -> &'static str {
         KktMethod::SchurPcg { .. } => "schur_pcg",
         KktMethod::Penalty { .. } => "penalty",
         KktMethod::Compliant { .. } => "compliant",
+        KktMethod::AugmentedLagrangian { .. } => "augmented_lagrangian",
     }
 }
