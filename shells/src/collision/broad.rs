@@ -75,6 +75,69 @@ impl BroadPhase {
     }
 }
 
+impl BroadPhase {
+    /// The candidate pairs of [`BroadPhase::candidate_pairs`] that involve at least one vertex
+    /// with `changed[v]`, found by refitting the trees and querying only the boxes of changed
+    /// vertices, of triangles and of edges with a changed vertex (same boxes, same closed-box
+    /// overlap test, hence exactly the subset of the full list; sorted, deduplicated).
+    pub fn candidate_pairs_touching(
+        &mut self,
+        tris: &[[u32; 3]],
+        edges: &[[u32; 2]],
+        bx: (&[Aabb], &[Aabb], &[Aabb]),
+        changed: &[bool],
+    ) -> (Pairs, Pairs) {
+        let (vbox, tbox, ebox) = bx;
+        match &mut self.trees {
+            Some([v, t, e]) => {
+                v.refit(vbox);
+                t.refit(tbox);
+                e.refit(ebox);
+            }
+            None => {
+                self.trees = Some([AabbTree::build(vbox), AabbTree::build(tbox), AabbTree::build(ebox)]);
+                self.steps_since_build = 0;
+            }
+        }
+        let [v_tree, t_tree, e_tree] = self.trees.as_ref().expect("built just above");
+        let mut vt = Vec::new();
+        for (v, b) in vbox.iter().enumerate().filter(|&(v, _)| changed[v]) {
+            let v = v as u32;
+            t_tree.query(b, |t| {
+                if !tris[t as usize].contains(&v) {
+                    vt.push((v, t));
+                }
+            });
+        }
+        for (t, tri) in tris.iter().enumerate() {
+            if tri.iter().any(|&i| changed[i as usize]) {
+                v_tree.query(&tbox[t], |v| {
+                    if !tri.contains(&v) {
+                        vt.push((v, t as u32));
+                    }
+                });
+            }
+        }
+        vt.sort_unstable();
+        vt.dedup();
+        let mut ee = Vec::new();
+        for (e, ea) in edges.iter().enumerate() {
+            if ea.iter().any(|&i| changed[i as usize]) {
+                e_tree.query(&ebox[e], |f| {
+                    let eb = edges[f as usize];
+                    if f as usize != e && !eb.contains(&ea[0]) && !eb.contains(&ea[1]) {
+                        let e = e as u32;
+                        ee.push((e.min(f), e.max(f)));
+                    }
+                });
+            }
+        }
+        ee.sort_unstable();
+        ee.dedup();
+        (vt, ee)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -115,6 +178,20 @@ mod tests {
             }
             assert_eq!(vt, bvt, "round {round}");
             assert_eq!(ee, bee, "round {round}");
+            // The changed-vertex subset equals the full list filtered to pairs touching them.
+            let changed: Vec<bool> = (0..n).map(|i| i % 7 == round).collect();
+            let (svt, see) = bp.candidate_pairs_touching(&tris, &edges, (&vb, &tb, &eb), &changed);
+            let c = |i: u32| changed[i as usize];
+            let fvt: Vec<_> =
+                bvt.iter().copied().filter(|&(v, t)| c(v) || tris[t as usize].iter().any(|&i| c(i))).collect();
+            let fee: Vec<_> = bee
+                .iter()
+                .copied()
+                .filter(|&(e, f)| edges[e as usize].iter().chain(&edges[f as usize]).any(|&i| c(i)))
+                .collect();
+            assert!(!fvt.is_empty() && !fee.is_empty(), "the subset test must see pairs");
+            assert_eq!(svt, fvt, "round {round}");
+            assert_eq!(see, fee, "round {round}");
             assert!(bp.is_built());
             for p in &mut pts {
                 p.x = 1.0 - p.x * p.x;

@@ -27,23 +27,29 @@ fn at(x: &[Pt3; 4], d: &[Vec3; 4], t: f64) -> [Pt3; 4] {
 }
 
 /// Candidate times: the cubic's roots in [0, 1], or the sample times {0, ¼, ½, ¾, 1} when the
-/// motion is coplanar throughout (all coefficients negligible).
-fn candidate_times(x: &[Pt3; 4], d: &[Vec3; 4], out: &mut Vec<f64>) {
-    out.clear();
+/// motion is coplanar throughout (all coefficients negligible). Returns the times and their
+/// count (no allocation: this runs for every broad-phase candidate pair).
+fn candidate_times(x: &[Pt3; 4], d: &[Vec3; 4]) -> ([f64; 5], usize) {
+    let mut out = [0.0; 5];
     let c = coplanarity_cubic(x, d);
-    let scale = x
-        .iter()
-        .chain(x.iter())
-        .zip(d.iter().chain(d.iter()))
-        .fold(0.0f64, |m, (p, v)| m.max((p - x[0]).norm()).max(v.norm()));
+    // Largest of |x_i − x_0| and |d_i| (squared norms, one square root: the same value).
+    let scale = x.iter().zip(d).fold(0.0f64, |m, (p, v)| m.max((p - x[0]).norm_squared()).max(v.norm_squared())).sqrt();
     let tol = 1e-14 * scale.powi(3).max(f64::MIN_POSITIVE);
     if c.iter().all(|v| v.abs() <= tol) {
-        out.extend_from_slice(&[0.0, 0.25, 0.5, 0.75, 1.0]);
-        return;
+        out = [0.0, 0.25, 0.5, 0.75, 1.0];
+        return (out, 5);
+    }
+    // Bernstein coefficients on [0, 1]: the cubic lies in their convex hull there, so when all
+    // four are beyond ±tol with one sign it has no root in [0, 1] (the common case of a broad-
+    // phase candidate that never becomes coplanar), and the root finder is skipped.
+    let b = [c[0], c[0] + c[1] / 3.0, c[0] + (2.0 * c[1] + c[2]) / 3.0, c[0] + c[1] + c[2] + c[3]];
+    if b.iter().all(|&x| x > tol) || b.iter().all(|&x| x < -tol) {
+        return (out, 0);
     }
     let mut r = [0.0; 3];
     let k = cubic_roots_unit(c, &mut r);
-    out.extend_from_slice(&r[..k]);
+    out[..k].copy_from_slice(&r[..k]);
+    (out, k)
 }
 
 /// First time t ∈ [0, 1] at which vertex p (moving by dp) comes within `delta` of the triangle
@@ -51,9 +57,8 @@ fn candidate_times(x: &[Pt3; 4], d: &[Vec3; 4], out: &mut Vec<f64>) {
 pub fn vertex_triangle(p: &Pt3, dp: &Vec3, tri: &[Pt3; 3], dt: &[Vec3; 3], delta: f64) -> Option<(f64, [f64; 3])> {
     let x = [tri[0], tri[1], tri[2], *p];
     let d = [dt[0], dt[1], dt[2], *dp];
-    let mut times = Vec::with_capacity(5);
-    candidate_times(&x, &d, &mut times);
-    for &t in &times {
+    let (times, k) = candidate_times(&x, &d);
+    for &t in &times[..k] {
         let y = at(&x, &d, t);
         let (c, w) = closest_point_triangle(&y[3], &[y[0], y[1], y[2]]);
         if (y[3] - c).norm() <= delta {
@@ -68,9 +73,8 @@ pub fn vertex_triangle(p: &Pt3, dp: &Vec3, tri: &[Pt3; 3], dt: &[Vec3; 3], delta
 pub fn edge_edge(a: &[Pt3; 2], da: &[Vec3; 2], b: &[Pt3; 2], db: &[Vec3; 2], delta: f64) -> Option<(f64, f64, f64)> {
     let x = [a[0], a[1], b[0], b[1]];
     let d = [da[0], da[1], db[0], db[1]];
-    let mut times = Vec::with_capacity(5);
-    candidate_times(&x, &d, &mut times);
-    for &t in &times {
+    let (times, k) = candidate_times(&x, &d);
+    for &t in &times[..k] {
         let y = at(&x, &d, t);
         let (s, u, p, q) = closest_points_segments(&y[0], &y[1], &y[2], &y[3]);
         if (p - q).norm() <= delta {
@@ -102,6 +106,31 @@ mod tests {
         assert_eq!(cubic_roots_unit([0.0, 1.0, 0.0, 0.0], &mut r), 1);
         assert_eq!(r[0], 0.0);
         assert_eq!(cubic_roots_unit([1.0, 0.0, 1.0, 0.0], &mut r), 0);
+    }
+
+    /// The Bernstein pre-test only skips cubics without a root in [0, 1]: on random cubics
+    /// (and ones with planted roots) the candidate times equal those of the root finder alone.
+    #[test]
+    fn bernstein_skip_is_exact() {
+        let mut rng = TestRng::new(5);
+        let mut skipped = 0;
+        for k in 0..20_000 {
+            let c = if k % 2 == 0 {
+                [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)]
+            } else {
+                // (t − r₀)(t − r₁)(t − r₂)·s with roots scattered around [0, 1].
+                let (a, b, d, s) =
+                    (rng.range(-0.5, 1.5), rng.range(-0.5, 1.5), rng.range(-0.5, 1.5), rng.range(-2.0, 2.0));
+                [-s * a * b * d, s * (a * b + a * d + b * d), -s * (a + b + d), s]
+            };
+            let b = [c[0], c[0] + c[1] / 3.0, c[0] + (2.0 * c[1] + c[2]) / 3.0, c[0] + c[1] + c[2] + c[3]];
+            if b.iter().all(|&x| x > 1e-14) || b.iter().all(|&x| x < -1e-14) {
+                skipped += 1;
+                let mut r = [0.0; 3];
+                assert_eq!(cubic_roots_unit(c, &mut r), 0, "skipped a cubic with a root in [0, 1]: {c:?}");
+            }
+        }
+        assert!(skipped > 2000, "the pre-test must skip often: {skipped}");
     }
 
     /// §7 test 16: a vertex crossing a triangle at t* = 0.37; an edge–edge crossing; grazing

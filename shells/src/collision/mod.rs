@@ -74,6 +74,17 @@ pub(crate) struct Collider {
     obstacle_accel: Vec<Option<geom_core::collide::MeshQuery>>,
     thin: f64,
     broad: BroadPhase,
+    /// Velocities and hits of the last CCD of the current [`Collider::filter`] call.
+    ccd_cache: Option<CcdCache>,
+}
+
+/// A CCD pair: (0, vertex, triangle) or (1, edge, edge); sorting by it gives the hit order.
+type PairKey = (u8, u32, u32);
+
+/// The velocities the last CCD ran with and its keyed hits (see [`Collider::ccd_hits`]).
+struct CcdCache {
+    v: Vec<Vec3>,
+    hits: Vec<(PairKey, Stencil)>,
 }
 
 impl Collider {
@@ -95,6 +106,7 @@ impl Collider {
             obstacle_accel: effects.obstacles.iter().map(obstacles::mesh_query).collect(),
             thin: 2.0 * mean_edge,
             broad: BroadPhase::default(),
+            ccd_cache: None,
         }
     }
 
@@ -106,6 +118,8 @@ impl Collider {
             return;
         }
         self.broad.next_step();
+        // q changes between calls: the CCD cache is valid within one call only.
+        self.ccd_cache = None;
         if self.self_collision {
             self.proximity(q, v, h, im, st);
         }
@@ -141,6 +155,13 @@ impl Collider {
     /// Candidate (vertex, triangle) and (edge, edge) pairs for the motion q → q + h v: swept
     /// boxes inflated by `margin`, through the refitted trees of the broad phase.
     fn candidates(&mut self, q: &[Pt3], v: Option<&[Vec3]>, h: f64, margin: f64) -> (broad::Pairs, broad::Pairs) {
+        let (vb, tb, eb) = self.swept_boxes(q, v, h, margin);
+        self.broad.candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb)
+    }
+
+    /// Boxes of the vertices (swept over q → q + h v when `v` is given), triangles and edges,
+    /// inflated by `margin`.
+    fn swept_boxes(&self, q: &[Pt3], v: Option<&[Vec3]>, h: f64, margin: f64) -> (Vec<Aabb>, Vec<Aabb>, Vec<Aabb>) {
         // Vertex boxes first; triangle and edge boxes are unions of their vertices' boxes.
         let vb: Vec<Aabb> = match v {
             Some(v) => q.iter().zip(v).map(|(p, w)| Aabb::from_points(&[*p, p + h * w]).grow(margin)).collect(),
@@ -149,7 +170,7 @@ impl Collider {
         let tb: Vec<Aabb> =
             self.tris.iter().map(|t| vb[t[0] as usize].union(&vb[t[1] as usize]).union(&vb[t[2] as usize])).collect();
         let eb: Vec<Aabb> = self.edges.iter().map(|e| vb[e[0] as usize].union(&vb[e[1] as usize])).collect();
-        self.broad.candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb)
+        (vb, tb, eb)
     }
 
     /// Step 1: proximity at q with inelastic + repulsion impulses and friction.
@@ -304,12 +325,68 @@ impl Collider {
         }
     }
 
-    /// All CCD hits of the motion q → q + h v, as stencils with separating normals.
+    /// All CCD hits of the motion q → q + h v, as stencils with separating normals, in the order
+    /// of the sorted (vertex, triangle) pairs, then the sorted (edge, edge) pairs.
+    ///
+    /// Within one [`Collider::filter`] call q is fixed and only some velocities change between
+    /// calls (CCD passes, impact-zone iterations, freezing), so after the first call only pairs
+    /// with a vertex whose velocity changed are tested again; every other pair has the same
+    /// swept boxes and the same motion, hence the same result as in the previous call. The hit
+    /// list is therefore identical (same stencils, same order) to a full recomputation — checked
+    /// by `incremental_ccd_equals_full` — at a cost proportional to what moved.
     fn ccd_hits(&mut self, q: &[Pt3], v: &[Vec3], h: f64) -> Vec<Stencil> {
         let delta = self.delta_ccd;
-        let (vt, ee) = self.candidates(q, Some(v), h, delta);
+        let keyed: Vec<(PairKey, Stencil)> = match self.ccd_cache.take() {
+            Some(cache) if cache.v.len() == v.len() => {
+                let changed: Vec<bool> = cache.v.iter().zip(v).map(|(a, b)| a != b).collect();
+                if !changed.contains(&true) {
+                    cache.hits
+                } else {
+                    let (vb, tb, eb) = self.swept_boxes(q, Some(v), h, delta);
+                    // Few changed vertices: query their boxes; many: one dual-tree traversal,
+                    // then keep the pairs that touch them (the same list either way).
+                    let n_changed = changed.iter().filter(|&&c| c).count();
+                    let (vt, ee) = if 4 * n_changed < v.len() {
+                        self.broad.candidate_pairs_touching(&self.tris, &self.edges, (&vb, &tb, &eb), &changed)
+                    } else {
+                        let (mut vt, mut ee) = self.broad.candidate_pairs(&self.tris, &self.edges, &vb, &tb, &eb);
+                        let c = |i: u32| changed[i as usize];
+                        vt.retain(|&(p, t)| c(p) || self.tris[t as usize].iter().any(|&i| c(i)));
+                        ee.retain(|&(e, f)| {
+                            self.edges[e as usize].iter().chain(&self.edges[f as usize]).any(|&i| c(i))
+                        });
+                        (vt, ee)
+                    };
+                    let mut out: Vec<(PairKey, Stencil)> =
+                        cache.hits.into_iter().filter(|(_, s)| s.v.iter().all(|&i| !changed[i as usize])).collect();
+                    out.extend(self.narrow_ccd(q, v, h, &vt, &ee));
+                    out.sort_unstable_by_key(|&(k, _)| k);
+                    out
+                }
+            }
+            _ => {
+                let (vt, ee) = self.candidates(q, Some(v), h, delta);
+                self.narrow_ccd(q, v, h, &vt, &ee)
+            }
+        };
+        let hits = keyed.iter().map(|&(_, s)| s).collect();
+        self.ccd_cache = Some(CcdCache { v: v.to_vec(), hits: keyed });
+        hits
+    }
+
+    /// Narrow-phase CCD of the given candidate pairs (vertex–triangle, edge–edge), keyed by
+    /// pair, in the input order (vt first).
+    fn narrow_ccd(
+        &self,
+        q: &[Pt3],
+        v: &[Vec3],
+        h: f64,
+        vt: &[(u32, u32)],
+        ee: &[(u32, u32)],
+    ) -> Vec<(PairKey, Stencil)> {
+        let delta = self.delta_ccd;
         let dv = |i: u32| h * v[i as usize];
-        let mut hits: Vec<Stencil> = par_filter_map(&vt, |&(p, t)| {
+        let mut hits: Vec<(PairKey, Stencil)> = par_filter_map(vt, |&(p, t)| {
             let tri = self.tris[t as usize];
             let x = tri.map(|i| q[i as usize]);
             let d = tri.map(dv);
@@ -323,9 +400,9 @@ impl Collider {
             if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
                 nrm = -nrm;
             }
-            Some(Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm })
+            Some(((0, p, t), Stencil { v: [p, tri[0], tri[1], tri[2]], c: [1.0, -w[0], -w[1], -w[2]], n: nrm }))
         });
-        let ee_hits: Vec<Stencil> = par_filter_map(&ee, |&(e, f)| {
+        let ee_hits: Vec<(PairKey, Stencil)> = par_filter_map(ee, |&(e, f)| {
             let (a, b) = (self.edges[e as usize], self.edges[f as usize]);
             let xa = [q[a[0] as usize], q[a[1] as usize]];
             let xb = [q[b[0] as usize], q[b[1] as usize]];
@@ -341,7 +418,7 @@ impl Collider {
             if side < 0.0 || (side == 0.0 && rel.dot(&nrm) > 0.0) {
                 nrm = -nrm;
             }
-            Some(Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm })
+            Some(((1, e, f), Stencil { v: [a[0], a[1], b[0], b[1]], c: [1.0 - s, s, -(1.0 - u), -u], n: nrm }))
         });
         hits.extend(ee_hits);
         hits
@@ -364,6 +441,7 @@ impl Collider {
             // Only the vertices that take part in the contact (weight ≠ 0) join the zone: a
             // vertex–triangle hit at an edge or corner of the triangle does not drag the
             // triangle's third vertex (and everything it is connected to) into the zone.
+            let mut touched = Vec::new();
             for s in &hits {
                 let mut first = None;
                 for k in 0..4 {
@@ -371,6 +449,7 @@ impl Collider {
                         continue;
                     }
                     in_zone[s.v[k] as usize] = true;
+                    touched.push(s.v[k]);
                     match first {
                         None => first = Some(s.v[k]),
                         Some(f) => {
@@ -379,7 +458,14 @@ impl Collider {
                     }
                 }
             }
-            self.rigidify(q, v, im, &mut uf, &in_zone, st);
+            // Zones no hit touched in this iteration already move rigidly: recomputing their
+            // rigid motion would only change the last bits of their velocities (and make the
+            // incremental CCD re-test all their pairs), so only touched zones are rigidified.
+            let mut dirty = vec![false; n];
+            for &x in &touched {
+                dirty[uf.find(x) as usize] = true;
+            }
+            self.rigidify(q, v, im, &mut uf, &in_zone, &dirty, st);
             hits = self.ccd_hits(q, v, h);
             if hits.is_empty() {
                 return;
@@ -411,7 +497,9 @@ impl Collider {
         st.n_frozen += frozen.iter().filter(|&&f| f).count() as u32;
     }
 
-    /// Sets every zone's velocities to its rigid motion (constrained vertices impose theirs).
+    /// Sets the velocities of every zone whose root is `dirty` to its rigid motion (constrained
+    /// vertices impose theirs).
+    #[allow(clippy::too_many_arguments)]
     fn rigidify(
         &self,
         q: &[Pt3],
@@ -419,6 +507,7 @@ impl Collider {
         im: &[f64],
         uf: &mut UnionFind,
         in_zone: &[bool],
+        dirty: &[bool],
         st: &mut StepStats,
     ) {
         let n = q.len();
@@ -429,8 +518,11 @@ impl Collider {
             }
         }
         st.n_impact_zones = st.n_impact_zones.max(members.len() as u32);
-        for zone in members.values() {
+        for (&root, zone) in &members {
             st.max_zone_size = st.max_zone_size.max(zone.len() as u32);
+            if !dirty[root as usize] {
+                continue;
+            }
             let constrained: Vec<usize> = zone.iter().copied().filter(|&i| im[i] == 0.0).collect();
             if !constrained.is_empty() {
                 // Move with the prescribed velocity (mean if they disagree).
@@ -547,6 +639,62 @@ pub use geom_core::query::tri_tri_intersect;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The incremental CCD of later calls in one filter call equals a full recomputation (same
+    /// stencils bit for bit, same order), on a crumpled, self-overlapping random sheet whose
+    /// velocities change on a few vertices between calls, as CCD passes and impact zones do.
+    #[test]
+    fn incremental_ccd_equals_full() {
+        use crate::material::Material;
+        let n = 12;
+        let mut rng = geom_core::rng::Rng::new(3);
+        // An n × n grid folded onto itself (z = sin), so many pairs are close.
+        let mut p = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (x, y) = (i as f64 / (n - 1) as f64, j as f64 / (n - 1) as f64);
+                p.push(Pt3::new(x, 0.3 * (6.0 * y).sin(), 0.05 * (y * 9.0).cos() + 0.01 * rng.range(-1.0, 1.0)));
+            }
+        }
+        let mut f = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = (j * n + i) as u32;
+                f.push([a, a + 1, a + n as u32 + 1]);
+                f.push([a, a + n as u32 + 1, a + n as u32]);
+            }
+        }
+        let mesh = ShellMesh::new(p.clone(), &f, None, &Material::cotton()).expect("valid grid");
+        let effects = Effects { self_collision: true, ..Effects::default() };
+        let cs = CollisionSettings::default();
+        let mut inc = Collider::new(&mesh, &effects, &cs, 1.0);
+        let mut full = Collider::new(&mesh, &effects, &cs, 1.0);
+        let mut v: Vec<Vec3> =
+            (0..p.len()).map(|_| Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-3.0, 3.0))).collect();
+        let h = 0.05;
+        let mut total = 0;
+        for call in 0..6 {
+            let a = inc.ccd_hits(&p, &v, h);
+            full.ccd_cache = None;
+            let b = full.ccd_hits(&p, &v, h);
+            assert_eq!(a.len(), b.len(), "call {call}");
+            for (x, y) in a.iter().zip(&b) {
+                assert!(x.v == y.v && x.c == y.c && x.n == y.n, "call {call}: hit lists differ");
+            }
+            total += a.len();
+            // Change half of the velocities once (the bulk path), else a few (the query path).
+            if call == 2 {
+                for k in (0..p.len()).step_by(2) {
+                    v[k] *= 0.5;
+                }
+            }
+            for _ in 0..5 {
+                let k = (rng.range(0.0, 1.0) * p.len() as f64) as usize % p.len();
+                v[k] = if call % 2 == 0 { Vec3::zeros() } else { Vec3::new(0.0, 0.0, rng.range(-5.0, 5.0)) };
+            }
+        }
+        assert!(total > 20, "the test must see hits: {total}");
+    }
 
     /// Two crossing triangles count once; sharing a vertex makes them adjacent (not counted).
     #[test]
