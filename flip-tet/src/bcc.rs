@@ -34,6 +34,14 @@ pub struct TetMesh {
     pub face_nbr: Vec<[u32; 4]>,
     /// Incident tets per node.
     pub node_tets: Ragged<u32>,
+    /// Edge neighbours per node (sorted ascending, no duplicates), filled by
+    /// [`TetMesh::compute_geometry`]; the same rows as `surface::node_edges`, cached because the
+    /// level set and the redistancing need them every step.
+    pub node_nbrs: Ragged<u32>,
+    /// Local mesh size per node (m): the largest `(12 V)^{1/3}` over the incident tets (the cube
+    /// edge of a regular BCC tet), filled by [`TetMesh::compute_geometry`]; equals
+    /// `surface::node_sizes` bit for bit.
+    pub node_h: Vec<f64>,
     /// Tets having the leaf's centre as a vertex, per octree leaf (point location).
     pub leaf_tets: Ragged<u32>,
     /// Fluid (non-solid) fraction `w_t ∈ [0, 1]` per tet when obstacles exist.
@@ -330,6 +338,25 @@ impl TetMesh {
         let pairs: Vec<(u32, u32)> =
             self.tets.iter().enumerate().flat_map(|(ti, t)| t.map(|i| (i, ti as u32))).collect();
         self.node_tets = Ragged::from_pairs(self.nodes.len(), &pairs);
+        let (tets, node_tets, nodes) = (&self.tets, &self.node_tets, &self.nodes);
+        let per_node: Vec<(Vec<u32>, f64)> = (0..nodes.len())
+            .into_par_iter()
+            .map(|i| {
+                let mut nb = Vec::with_capacity(16);
+                let mut h = 0.0f64;
+                for &t in node_tets.row(i) {
+                    let tv = tets[t as usize];
+                    nb.extend(tv.iter().copied().filter(|&j| j as usize != i));
+                    let [a, b, c, d] = tv.map(|v| nodes[v as usize]);
+                    h = h.max((12.0 * crate::surface::tet_volume(&a, &b, &c, &d)).cbrt());
+                }
+                nb.sort_unstable();
+                nb.dedup();
+                (nb, h)
+            })
+            .collect();
+        self.node_nbrs = Ragged::from_rows(per_node.iter().map(|(nb, _)| nb));
+        self.node_h = per_node.iter().map(|(_, h)| *h).collect();
         Ok(())
     }
 

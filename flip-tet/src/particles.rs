@@ -107,7 +107,12 @@ impl Particles {
 }
 
 /// Ballistic classification (spec §3.8): a particle with no other particle centre within
-/// `factor · r_p` is ballistic. Returns the number of ballistic particles.
+/// `factor · r_p` (closed ball) is ballistic. Returns the number of ballistic particles.
+///
+/// Only the nearest other particle matters, so each particle asks the tree for its two nearest
+/// points (itself and the nearest other one, or two others at distance 0) instead of listing the
+/// whole ball; the distance test is the tree's own `|x_i − x_j|² ≤ (factor r_i)²` expression, so
+/// the classification equals the radius-query definition exactly.
 pub fn classify_ballistic(parts: &mut Particles, tree: &KdTree, factor: f64, enabled: bool) -> usize {
     let flags: Vec<bool> = (0..parts.len())
         .into_par_iter()
@@ -115,9 +120,19 @@ pub fn classify_ballistic(parts: &mut Particles, tree: &KdTree, factor: f64, ena
             if !enabled {
                 return false;
             }
-            buf.clear();
-            tree.within(&parts.x[i], factor * parts.r[i], buf);
-            !buf.iter().any(|&j| j as usize != i)
+            let xi = parts.x[i];
+            let reach = factor * parts.r[i];
+            if reach.is_nan() || reach < 0.0 {
+                // The radius query of an invalid radius is empty: no neighbour.
+                return true;
+            }
+            let r2 = reach * reach;
+            tree.knn(&xi, 2, buf);
+            !buf.iter().any(|&(j, _)| {
+                let xj = parts.x[j as usize];
+                let (dx, dy, dz) = (xi.x - xj.x, xi.y - xj.y, xi.z - xj.z);
+                j as usize != i && dx * dx + dy * dy + dz * dz <= r2
+            })
         })
         .collect();
     let mut n = 0;
@@ -207,8 +222,8 @@ pub fn position_correction(
             let (xi, ri) = (parts.x[i], parts.r[i]);
             let vi = parts.volume(i);
             buf.clear();
+            // `within` returns the indices sorted ascending (the summation order below).
             tree.within(&xi, ri + rmax, buf);
-            buf.sort_unstable();
             let mut d = Vec3::zeros();
             for &j in buf.iter() {
                 let j = j as usize;
@@ -258,5 +273,43 @@ pub fn position_correction(
         .collect();
     for (x, d) in parts.x.iter_mut().zip(dx) {
         *x += d;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geom_core::rng::Rng;
+
+    #[test]
+    fn ballistic_classification_equals_the_radius_query_definition() {
+        // Clusters, isolated particles, exact duplicates and particles exactly at the reach:
+        // the two-nearest test must agree with "no other centre in the closed ball" everywhere.
+        let mut rng = Rng::new(4);
+        let mut p = Particles::default();
+        for _ in 0..400 {
+            let x = Pt3::new(rng.range(0.0, 1.0), rng.range(0.0, 1.0), rng.range(0.0, 1.0));
+            p.push(x, Vec3::zeros(), rng.range(0.002, 0.03), 0.0);
+        }
+        let x0 = p.x[0];
+        p.push(x0, Vec3::zeros(), 0.01, 0.0); // duplicate of particle 0
+        p.push(x0, Vec3::zeros(), 0.01, 0.0); // and another
+        p.push(Pt3::new(2.0, 2.0, 2.0), Vec3::zeros(), 0.05, 0.0);
+        p.push(Pt3::new(2.25, 2.0, 2.0), Vec3::zeros(), 0.05, 0.0); // exactly 5 r away
+        let tree = KdTree::build(&p.x);
+        for factor in [1.0, 3.0, 5.0, 6.0] {
+            let n = classify_ballistic(&mut p, &tree, factor, true);
+            let mut buf = Vec::new();
+            let mut expect = 0;
+            for i in 0..p.len() {
+                tree.within(&p.x[i], factor * p.r[i], &mut buf);
+                let b = !buf.iter().any(|&j| j as usize != i);
+                assert_eq!(p.is_ballistic(i), b, "particle {i}, factor {factor}");
+                expect += usize::from(b);
+            }
+            assert_eq!(n, expect);
+            assert!(n > 0 && n < p.len(), "factor {factor}: degenerate sample ({n} ballistic)");
+        }
+        assert_eq!(classify_ballistic(&mut p, &tree, 6.0, false), 0);
     }
 }

@@ -9,6 +9,7 @@
 mod extract;
 mod hull;
 mod levelset;
+mod spheretree;
 #[cfg(test)]
 pub(crate) mod test_mesh;
 mod volume;
@@ -20,6 +21,8 @@ pub use hull::{facet_distance, hull_distance, pair_distance};
 pub use levelset::{
     extend_into_solids, level_set_on_nodes, node_edges, node_sizes, redistance_interior, LevelSetSampler, Walls,
 };
+pub use spheretree::SphereTree;
+pub(crate) use volume::tet_volume;
 pub use volume::{liquid_volume, tet_liquid_volume};
 
 /// How the level set is built from the particles (spec §4 `surface.method`, §9 sweep).

@@ -175,3 +175,20 @@ fn t_locate_agrees_with_brute_force_and_walk() {
         assert!(l.iter().copied().fold(f64::INFINITY, f64::min) >= -1e-12);
     }
 }
+
+#[test]
+fn cached_node_neighbours_and_sizes_equal_the_surface_functions() {
+    // `compute_geometry` caches the edge rows and node sizes the level set needs every step; they
+    // must equal the reference functions of `surface` exactly (bitwise sizes, identical rows).
+    for seed in [3, 8] {
+        let mesh = tetrahedralize(&random_octree(seed, 4)).expect("mesh");
+        let edges = flip_tet::surface::node_edges(&mesh);
+        assert_eq!(mesh.node_nbrs.len(), mesh.nodes.len());
+        for i in 0..mesh.nodes.len() {
+            assert_eq!(mesh.node_nbrs.row(i), edges.row(i), "node {i}");
+        }
+        let h = flip_tet::surface::node_sizes(&mesh);
+        assert_eq!(h.len(), mesh.node_h.len());
+        assert!(h.iter().zip(&mesh.node_h).all(|(a, b)| a.to_bits() == b.to_bits()));
+    }
+}

@@ -8,6 +8,7 @@ use crate::db::Database;
 use crate::error::{Error, Result};
 use crate::features::{FeatureTable, JointWeights};
 use crate::kmeans::{bisect, kmeans, pca};
+use crate::rigid::Rigid2;
 use geom_core::graph::UnionFind;
 use geom_core::rng::{splitmix64, Rng};
 use rayon::prelude::*;
@@ -139,6 +140,12 @@ pub struct MotionGraph {
     pub component: Vec<u32>,
     /// Minimum self gap used.
     pub min_self_gap: u32,
+    /// Torso frame of every database frame (global index, as [`FeatureTable::torso`]) with its
+    /// rotation as `(cos, sin)`: the search places pieces without trigonometry.
+    pub torso_r: Vec<Rigid2>,
+    /// Per edge node `(s, i) → (t, j)`: `T(s, i+1) ∘ T(t, j)⁻¹`, so the piece entered by the cut
+    /// is placed at `W_prev ∘ delta` (§3.5).
+    pub delta: Vec<Rigid2>,
 }
 
 /// Leaf edges `(i, j, cost)` of one ordered clip pair.
@@ -344,9 +351,20 @@ impl MotionGraph {
             tau,
             empty_clusters: empty,
         };
+        let torso_r: Vec<Rigid2> = feats.torso.iter().map(|&t| Rigid2::from(t)).collect();
+        let delta = edges
+            .iter()
+            .map(|n| {
+                let a = torso_r[feats.global(n.from.clip, n.from.frame + 1)];
+                let b = torso_r[feats.global(n.to.clip, n.to.frame)];
+                a.compose(&b.inverse())
+            })
+            .collect();
         Ok(MotionGraph {
             db,
             features: feats,
+            torso_r,
+            delta,
             edges,
             top,
             tau,
@@ -367,6 +385,12 @@ impl MotionGraph {
     /// Length of clip `c` (frames).
     pub fn clip_len(&self, c: u32) -> u32 {
         self.db.clips[c as usize].len() as u32
+    }
+
+    /// Torso frame `T(clip, frame)` as a [`Rigid2`].
+    #[inline]
+    pub fn torso_r(&self, clip: u32, frame: u32) -> Rigid2 {
+        self.torso_r[self.features.global(clip, frame)]
     }
 }
 

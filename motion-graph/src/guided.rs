@@ -26,7 +26,8 @@
 
 use crate::graph::{EdgeId, FrameRef, MotionGraph};
 use crate::path::{hard_ok, score, Compiled, Hard, Path, Scored};
-use geom_core::math::{wrap_angle, Planar};
+use crate::rigid::Rigid2;
+use geom_core::math::wrap_angle;
 use geom_core::rng::Rng;
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
@@ -64,6 +65,10 @@ pub struct GuidedParams {
     /// Run the beam again (fresh random starts and draws) every this many search iterations and
     /// add its results to the population (0 = only at the start). Default 2.
     pub every: usize,
+    /// One-cut extensions per state: every leaf edge leaving the piece in time, or this many
+    /// drawn uniformly among them when there are more (0 = always all; at a hard constraint
+    /// always all). Default 0.
+    pub one_cut_draws: usize,
 }
 
 impl Default for GuidedParams {
@@ -80,6 +85,7 @@ impl Default for GuidedParams {
             slack_deg: 5.0,
             guide_slack: 0.5,
             every: 2,
+            one_cut_draws: 0,
         }
     }
 }
@@ -113,7 +119,7 @@ struct State {
     a: u32,
     ta: u32,
     /// Placement of the current piece.
-    w: Planar,
+    w: Rigid2,
     /// Earliest frame the current piece may be left from.
     min_from: u32,
     /// Accumulated score terms.
@@ -133,10 +139,13 @@ struct Ext {
     clip: u32,
     a: u32,
     ta: u32,
-    w: Planar,
+    w: Rigid2,
     /// Database frame at the checkpoint.
     frame: u32,
 }
+
+/// The beam first ranks the best `PREFIX × width` extensions only (selection, then sorting).
+const PREFIX: usize = 8;
 
 /// Rank added per clip-level hop still needed to reach a clip meeting the next hard constraint.
 const HOP_PENALTY: f64 = 20.0;
@@ -278,7 +287,7 @@ impl Beam<'_> {
         clip: u32,
         a: u32,
         ta: u32,
-        w: &Planar,
+        w: &Rigid2,
         jitter: f64,
     ) -> Option<(f64, f64, f64, u32)> {
         let f = a + (c.t - ta);
@@ -292,12 +301,12 @@ impl Beam<'_> {
             }
         }
         let feat = &self.g.features;
-        let wt = w.compose(&feat.torso(clip, f));
+        let wt = w.compose(&self.g.torso_r(clip, f));
         let (mut acc, mut racc) = (acc, racc);
         let (sp, sy) = if c.last { (0.0, 0.0) } else { (self.gp.slack_m, self.gp.slack_deg.to_radians()) };
         for &i in &c.body {
             let b = &self.cp.pb.body[i];
-            let e = (wt.x - b.x).hypot(wt.z - b.z);
+            let e = ((wt.x - b.x).powi(2) + (wt.z - b.z).powi(2)).sqrt();
             let dy = b.yaw.map_or(0.0, |y| wrap_angle(wt.yaw - y).abs());
             acc += self.cp.w_p * e * e + self.cp.w_o * dy * dy;
             racc += self.cp.w_p * (e - sp).max(0.0).powi(2) + self.cp.w_o * (dy - sy).max(0.0).powi(2);
@@ -310,7 +319,8 @@ impl Beam<'_> {
             racc += self.cp.w_j * (e - sp).max(0.0).powi(2);
         }
         let mut guide = c.guide.map_or(0.0, |(x, z, r)| {
-            self.gp.guide_weight * self.cp.w_p * ((wt.x - x).hypot(wt.z - z) - r).max(0.0).powi(2)
+            let d = ((wt.x - x).powi(2) + (wt.z - z).powi(2)).sqrt();
+            self.gp.guide_weight * self.cp.w_p * (d - r).max(0.0).powi(2)
         });
         if let Some(h) = &c.hops {
             guide += HOP_PENALTY * h[clip as usize].min(1000) as f64;
@@ -327,10 +337,9 @@ impl Beam<'_> {
     }
 
     /// The piece entered through edge `e` from a piece `(clip, a, ta, w)`: `(clip, a, ta, w)`.
-    fn follow(&self, e: EdgeId, a: u32, ta: u32, w: &Planar) -> (u32, u32, u32, Planar) {
+    fn follow(&self, e: EdgeId, a: u32, ta: u32, w: &Rigid2) -> (u32, u32, u32, Rigid2) {
         let n = &self.g.edges[e as usize];
-        let f = &self.g.features;
-        let w2 = w.compose(&f.torso(n.from.clip, n.from.frame + 1)).compose(&f.torso(n.to.clip, n.to.frame).inverse());
+        let w2 = w.compose(&self.g.delta[e as usize]);
         (n.to.clip, n.to.frame, ta + (n.from.frame - a) + 1, w2)
     }
 
@@ -359,11 +368,23 @@ impl Beam<'_> {
         let Some(hi) = (s.a + (c.t - s.ta)).checked_sub(1) else { return };
         let (lo1, hi1) = self.leaves(s.clip, s.min_from, hi);
         let outs = &g.out_leaf[s.clip as usize];
-        // 1 cut: every leaf edge.
-        for &e in &outs[lo1..hi1] {
+        // 1 cut: every leaf edge, or `one_cut_draws` of them drawn uniformly when there are more
+        // (dense graphs).
+        let one = |e: EdgeId, out: &mut Vec<Ext>, jitter: f64| {
             let (clip, a, ta, w) = self.follow(e, s.a, s.ta, &s.w);
-            if let Some((acc, racc, rank, frame)) = self.eval(c, plus(cost(e)), clip, a, ta, &w, rng.f64()) {
+            if let Some((acc, racc, rank, frame)) = self.eval(c, plus(cost(e)), clip, a, ta, &w, jitter) {
                 out.push(Ext { rank, acc, racc, parent: si, fill: [e, 0], n: 1, clip, a, ta, w, frame });
+            }
+        };
+        let n1 = hi1 - lo1;
+        if self.gp.one_cut_draws == 0 || n1 <= self.gp.one_cut_draws || c.hard.is_some() {
+            for &e in &outs[lo1..hi1] {
+                one(e, out, rng.f64());
+            }
+        } else {
+            for _ in 0..self.gp.one_cut_draws {
+                let e = outs[lo1 + rng.below(n1)];
+                one(e, out, rng.f64());
             }
         }
         // At a hard constraint: every first edge, then every top edge into a clip that holds a
@@ -474,7 +495,7 @@ pub(crate) fn guided_seeds(
             clip: s.clip,
             a: s.frame,
             ta: 0,
-            w: cp.start.compose(&g.features.torso(s.clip, s.frame).inverse()),
+            w: cp.start_r.compose(&g.torso_r(s.clip, s.frame).inverse()),
             min_from: s.frame + minp - 1,
             acc: 0.0,
             racc: 0.0,
@@ -490,14 +511,31 @@ pub(crate) fn guided_seeds(
         if exts.is_empty() {
             return Err(format!("guided seeds: no path reaches frame {}", c.t));
         }
-        exts.sort_by(|x, y| x.rank.total_cmp(&y.rank));
+        // Rank order of the extensions: only a prefix is needed (the beam takes `width`, at
+        // most `per_parent` per state), so select the best `PREFIX × width` first and sort the
+        // rest only if the prefix runs out.
+        let mut order: Vec<(f64, u32)> = exts.iter().enumerate().map(|(i, x)| (x.rank, i as u32)).collect();
+        let cmp = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        let pre = (PREFIX * width).min(order.len());
+        if pre < order.len() {
+            order.select_nth_unstable_by(pre, cmp);
+        }
+        order[..pre].sort_unstable_by(cmp);
+        let mut sorted_rest = pre == order.len();
         let mut seen = HashSet::new();
         let mut children = vec![0usize; beam.len()];
         let mut next = Vec::with_capacity(width);
-        for x in &exts {
+        let mut pos = 0;
+        while pos < order.len() {
             if next.len() == width {
                 break;
             }
+            if pos == pre && !sorted_rest {
+                order[pre..].sort_unstable_by(cmp);
+                sorted_rest = true;
+            }
+            let x = &exts[order[pos].1 as usize];
+            pos += 1;
             if children[x.parent] >= gp.per_parent.max(1) || !seen.insert((x.clip, x.frame)) {
                 continue;
             }

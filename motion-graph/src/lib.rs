@@ -15,12 +15,14 @@
 pub mod assemble;
 pub mod db;
 pub mod error;
+pub(crate) mod eval;
 pub mod features;
 pub mod graph;
 pub mod guided;
 pub mod kmeans;
 pub mod path;
 pub mod problem;
+pub mod rigid;
 pub mod search;
 
 pub use assemble::{assemble, enforce_body, evaluate, fix_contacts, kernel, smooth, Assembled, ClipStats, Metrics};
@@ -30,5 +32,8 @@ pub use features::{FeatureTable, JointWeights};
 pub use graph::{EdgeId, EdgeNode, FrameRef, GraphParams, GraphStats, MotionGraph};
 pub use guided::GuidedParams;
 pub use path::{Path, ScoreParts, Scored};
-pub use problem::{BodyConstraint, Disc, HardConstraint, JointConstraint, Problem, StyleConstraint, Weights};
+pub use problem::{
+    random_mg1, BodyConstraint, Disc, HardConstraint, JointConstraint, Problem, StyleConstraint, Weights,
+};
+pub use rigid::Rigid2;
 pub use search::{Search, SearchParams, StepReport, Tolerance};

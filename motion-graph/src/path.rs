@@ -7,10 +7,12 @@
 //! `W_next = W_prev ∘ T(s, i+1) ∘ T(t, j)⁻¹`, so the world torso frame of frame `m` of a piece is
 //! `W ∘ T(clip, m)` and planar position and heading are continuous by construction.
 
+use crate::eval::{edge_sum, place_r, score_view, View};
 use crate::graph::{EdgeId, FrameRef, MotionGraph};
 use crate::problem::{HardConstraint, Problem};
+use crate::rigid::Rigid2;
 use crate::Error;
-use geom_core::math::{wrap_angle, Planar, Vec3};
+use geom_core::math::Planar;
 
 /// A path (§2.4).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -88,7 +90,7 @@ pub struct Scored {
 pub struct Compiled {
     pub(crate) pb: Problem,
     pub(crate) target: u32,
-    pub(crate) start: Planar,
+    pub(crate) start_r: Rigid2,
     pub(crate) hard: Vec<(u32, Hard)>,
     pub(crate) style: Vec<(u32, u32, u64, f64)>,
     pub(crate) w_f: f64,
@@ -165,7 +167,7 @@ impl Compiled {
         let unit = |u: f64| if u > 0.0 && u.is_finite() { 1.0 / (u * u) } else { 0.0 };
         let w = pb.weights;
         Ok(Compiled {
-            start: Planar::new(b0.x, b0.z, b0.yaw.unwrap_or(0.0)),
+            start_r: Rigid2::from(Planar::new(b0.x, b0.z, b0.yaw.unwrap_or(0.0))),
             target,
             hard,
             style,
@@ -187,42 +189,18 @@ pub(crate) fn hard_ok(g: &MotionGraph, h: &Hard, f: FrameRef) -> bool {
 }
 
 /// The pieces of `path` placed from `start`, or `None` if the path is invalid (§3.5 rules with
-/// `min_piece` frames per piece).
+/// `min_piece` frames per piece). Same placement as the search's [`place_r`].
 pub fn place(g: &MotionGraph, path: &Path, start: &Planar, min_piece: u32) -> Option<Vec<Piece>> {
-    let f = &g.features;
-    let mut out = Vec::with_capacity(path.cuts.len() + 1);
-    let (mut clip, mut first) = (path.start.clip, path.start.frame);
-    if clip as usize >= g.db.clips.len() || first >= g.clip_len(clip) {
+    let mut pieces = Vec::with_capacity(path.cuts.len() + 1);
+    if !place_r(g, path, &Rigid2::from(*start), min_piece, &mut pieces) {
         return None;
     }
-    let mut w = start.compose(&f.torso(clip, first).inverse());
-    let mut t0 = 0u32;
-    for &e in &path.cuts {
-        let n = g.edges.get(e as usize)?;
-        if n.from.clip != clip || n.from.frame < first || n.from.frame + 1 - first < min_piece {
-            return None;
-        }
-        out.push(Piece { clip, first, last: n.from.frame, t0, w });
-        t0 += n.from.frame - first + 1;
-        w = w.compose(&f.torso(clip, n.from.frame + 1)).compose(&f.torso(n.to.clip, n.to.frame).inverse());
-        clip = n.to.clip;
-        first = n.to.frame;
-    }
-    let len = g.clip_len(clip);
-    if path.end_frame >= len || path.end_frame < first || path.end_frame + 1 - first < min_piece {
-        return None;
-    }
-    out.push(Piece { clip, first, last: path.end_frame, t0, w });
-    Some(out)
-}
-
-/// The piece holding output frame `t` (clamped to the last frame) and the database frame.
-fn locate(pieces: &[Piece], t: u32) -> (&Piece, u32) {
-    let total = pieces.last().map_or(0, |p| p.t0 + p.last - p.first + 1);
-    let t = t.min(total.saturating_sub(1));
-    let k = pieces.partition_point(|p| p.t0 <= t).saturating_sub(1);
-    let p = &pieces[k];
-    (p, p.first + (t - p.t0))
+    Some(
+        pieces
+            .into_iter()
+            .map(|p| Piece { clip: p.clip, first: p.first, last: p.last, t0: p.t0, w: p.w.into() })
+            .collect(),
+    )
 }
 
 /// Scores a path (§3.6): `None` if invalid or a hard constraint is not met.
@@ -237,77 +215,19 @@ pub(crate) fn score_value(g: &MotionGraph, cp: &Compiled, path: &Path, min_piece
     score_into(g, cp, path, min_piece, None).map(|x| x.0)
 }
 
-/// Score, its parts and the output length; constraint errors go to `errs` when given.
+/// Score, its parts and the output length; constraint errors go to `errs` when given. The path
+/// is placed with [`place_r`] and scored by [`score_view`] (the same code the incremental
+/// candidate scoring of the search uses).
 fn score_into(
     g: &MotionGraph,
     cp: &Compiled,
     path: &Path,
     min_piece: u32,
-    mut errs: Option<&mut Errors>,
+    errs: Option<&mut Errors>,
 ) -> Option<(f64, ScoreParts, u32)> {
-    let pieces = place(g, path, &cp.start, min_piece)?;
-    let frames = pieces.last().map_or(0, |p| p.t0 + p.last - p.first + 1);
-    for (t, h) in &cp.hard {
-        if *t >= frames {
-            return None;
-        }
-        let (p, fr) = locate(&pieces, *t);
-        if !hard_ok(g, h, FrameRef { clip: p.clip, frame: fr }) {
-            return None;
-        }
+    let mut pieces = Vec::with_capacity(path.cuts.len() + 1);
+    if !place_r(g, path, &cp.start_r, min_piece, &mut pieces) {
+        return None;
     }
-    let f = &g.features;
-    let mut parts = ScoreParts {
-        edge: cp.pb.weights.cut * path.cuts.iter().map(|&e| g.edges[e as usize].cost as f64).sum::<f64>(),
-        ..Default::default()
-    };
-    let dl = frames as f64 - cp.target as f64;
-    parts.length = cp.w_f * dl * dl;
-    if let Some(e) = errs.as_deref_mut() {
-        e.length = dl.abs() as u32;
-    }
-    for b in &cp.pb.body {
-        let (p, fr) = locate(&pieces, b.time);
-        let wt = p.w.compose(&f.torso(p.clip, fr));
-        let e2 = (wt.x - b.x).powi(2) + (wt.z - b.z).powi(2);
-        let dy = b.yaw.map_or(0.0, |y| wrap_angle(wt.yaw - y));
-        parts.body += cp.w_p * e2 + cp.w_o * dy * dy;
-        if let Some(e) = errs.as_deref_mut() {
-            e.body_pos.push(e2.sqrt());
-            e.body_yaw_deg.push(dy.abs().to_degrees());
-        }
-    }
-    for j in &cp.pb.joints {
-        let (p, fr) = locate(&pieces, j.time);
-        let wt = p.w.compose(&f.torso(p.clip, fr));
-        let x = wt.apply_point(f.local(p.clip, fr, j.joint as usize));
-        let e2 = (x - j.pos).norm_squared();
-        parts.joint += cp.w_j * e2;
-        if let Some(e) = errs.as_deref_mut() {
-            e.joint.push(e2.sqrt());
-        }
-    }
-    for &(a, b, bit, w) in &cp.style {
-        let mut lacking = 0;
-        for t in a..=b.min(frames.saturating_sub(1)) {
-            let (p, fr) = locate(&pieces, t);
-            if g.db.clips[p.clip as usize].labels.bits.get(fr as usize).is_none_or(|x| x & bit == 0) {
-                lacking += 1;
-            }
-        }
-        parts.style += w * lacking as f64 / 30.0;
-    }
-    if !cp.pb.obstacles.is_empty() {
-        for t in (0..frames).step_by(5) {
-            let (p, fr) = locate(&pieces, t);
-            let wt = p.w.compose(&f.torso(p.clip, fr));
-            for d in &cp.pb.obstacles {
-                let dist = Vec3::new(wt.x - d.x, 0.0, wt.z - d.z).norm();
-                let pen = (d.radius - dist).max(0.0);
-                parts.obstacle += cp.pb.weights.obstacle * pen * pen;
-            }
-        }
-    }
-    let score = parts.edge + parts.length + parts.body + parts.joint + parts.style + parts.obstacle;
-    Some((score, parts, frames))
+    score_view(g, cp, &View::whole(&pieces), edge_sum(g, &path.cuts), errs)
 }

@@ -131,3 +131,78 @@ impl Problem {
         self.length.unwrap_or_else(|| self.body.iter().map(|b| b.time + 1).max().unwrap_or(1)).max(1)
     }
 }
+
+/// The random problems of MG-1 (spec §6.2, "football positions"): `n` problems of `frames`
+/// frames at `rate_hz`, starting at the origin facing +Z, with `intermediate.0 ..= intermediate.1`
+/// intermediate body constraints (times evenly spread, ±10 frames of jitter) and an end
+/// constraint at frame `frames − 1` with a heading. Consecutive constraints lie
+/// `U(dist_frac) · speed · Δt` apart (spec: ≤ 0.8 × 4 m/s × Δt, "reachable by the database's
+/// speeds") and the direction between them turns by up to `±turn` rad per segment (the
+/// scene's default 1 rad). Deterministic in `seed`.
+#[allow(clippy::too_many_arguments)]
+pub fn random_mg1(
+    n: usize,
+    frames: u32,
+    rate_hz: f64,
+    intermediate: (usize, usize),
+    speed: f64,
+    dist_frac: (f64, f64),
+    turn: f64,
+    seed: u64,
+    weights: Weights,
+) -> Vec<Problem> {
+    let mut rng = geom_core::rng::Rng::new(seed);
+    let frames = frames.max(2);
+    (0..n)
+        .map(|_| {
+            let k = intermediate.0 + rng.below(intermediate.1.saturating_sub(intermediate.0) + 1);
+            let mut body = vec![BodyConstraint { time: 0, x: 0.0, z: 0.0, yaw: Some(0.0) }];
+            let (mut x, mut z, mut dir) = (0.0, 0.0, 0.0f64);
+            let mut t_prev = 0u32;
+            for i in 1..=k + 1 {
+                let t = if i == k + 1 {
+                    frames - 1
+                } else {
+                    ((frames as f64 * i as f64 / (k + 1) as f64 + rng.range(-10.0, 10.0)) as u32)
+                        .min(frames - 2)
+                        .max(t_prev + 1)
+                };
+                let dt = t.saturating_sub(t_prev) as f64 / rate_hz;
+                let d = rng.range(dist_frac.0, dist_frac.1) * speed * dt;
+                dir += rng.range(-turn, turn);
+                x += d * dir.sin();
+                z += d * dir.cos();
+                let yaw = if i == k + 1 { Some(dir) } else { None };
+                body.push(BodyConstraint { time: t, x, z, yaw });
+                t_prev = t;
+            }
+            Problem { length: Some(frames), body, weights, ..Default::default() }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// MG-1 problems respect the spec's reachability bound (consecutive constraints at most
+    /// `dist_frac.1 · speed · Δt` apart, here 0.8 × 4 m/s), start at the origin, end at the last
+    /// frame with a heading, and are the same for the same seed.
+    #[test]
+    fn random_mg1_respects_the_reachability_bound() {
+        let pbs = random_mg1(50, 300, 30.0, (1, 3), 4.0, (0.3, 0.8), 1.0, 11, Weights::default());
+        assert_eq!(pbs, random_mg1(50, 300, 30.0, (1, 3), 4.0, (0.3, 0.8), 1.0, 11, Weights::default()));
+        for p in &pbs {
+            assert!(p.body.len() >= 3 && p.body.len() <= 5);
+            assert_eq!((p.body[0].time, p.body[0].x, p.body[0].z), (0, 0.0, 0.0));
+            let last = p.body.last().unwrap();
+            assert!(last.time == 299 && last.yaw.is_some());
+            for w in p.body.windows(2) {
+                assert!(w[1].time > w[0].time);
+                let dt = (w[1].time - w[0].time) as f64 / 30.0;
+                let d = (w[1].x - w[0].x).hypot(w[1].z - w[0].z);
+                assert!(d <= 0.8 * 4.0 * dt + 1e-9 && d >= 0.3 * 4.0 * dt - 1e-9, "{d} m in {dt} s");
+            }
+        }
+    }
+}

@@ -4,6 +4,7 @@
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
+use std::sync::OnceLock;
 
 use geom_core::graph::Ragged;
 use geom_core::math::Pt3;
@@ -11,6 +12,7 @@ use geom_core::spatial::KdTree;
 use rayon::prelude::*;
 
 use super::hull::{facet_distance, pair_distance};
+use super::spheretree::SphereTree;
 use super::volume::tet_volume;
 use super::{SurfaceMethod, SurfaceParams};
 use crate::bcc::TetMesh;
@@ -37,6 +39,9 @@ impl Walls<'_> {
     }
 }
 
+/// Relative rounding margin (× band) of the exact pruning bounds.
+const PRUNE_EPS: f64 = 1e-9;
+
 /// One source sphere of the level set (a particle or a mirrored copy).
 #[derive(Clone, Copy, Debug)]
 struct Source {
@@ -51,9 +56,16 @@ struct Source {
 #[derive(Debug)]
 pub struct LevelSetSampler {
     src: Vec<Source>,
-    all: KdTree,
+    /// k-d tree over all sources, built on first use (only the exhaustive reference and the
+    /// Zhu–Bridson method need it).
+    all: OnceLock<KdTree>,
     near_idx: Vec<u32>,
     near: KdTree,
+    /// All sources with their radii `r_temp`, for the pruned sphere-union query.
+    tree: SphereTree,
+    /// Largest `r_temp` among the near-surface sources (m): every shape of [`Self::hulls`] has
+    /// signed distance `≥ −near_r_max`, so a node with a sphere-union value below it needs no hulls.
+    near_r_max: f64,
     /// Largest particle radius (original `r`, not `r_temp`): sets the band and search radius.
     r_max: f64,
     params: SurfaceParams,
@@ -93,11 +105,14 @@ impl LevelSetSampler {
             }
         }
         let pts: Vec<Pt3> = src.iter().map(|s| s.x).collect();
-        let all = KdTree::build(&pts);
+        let all = OnceLock::new();
         let near_idx: Vec<u32> = (0..src.len() as u32).filter(|&i| src[i as usize].near).collect();
         let near_pts: Vec<Pt3> = near_idx.iter().map(|&i| pts[i as usize]).collect();
         let near = KdTree::build(&near_pts);
-        Self { src, all, near_idx, near, r_max, params: params.clone() }
+        let radii: Vec<f64> = src.iter().map(|s| s.r).collect();
+        let tree = SphereTree::build(&pts, &radii);
+        let near_r_max = near_idx.iter().map(|&i| src[i as usize].r).fold(0.0, f64::max);
+        Self { src, all, near_idx, near, tree, near_r_max, r_max, params: params.clone() }
     }
 
     /// Number of source spheres (particles plus mirror images).
@@ -117,7 +132,73 @@ impl LevelSetSampler {
 
     /// Level-set value at `q` (m, negative inside) for a point whose local mesh size is `h` (m);
     /// values beyond the band are clamped to `±band` (spec §3.11.3). With no sources, `+band`.
+    ///
+    /// Fast path: the sphere-union part by the pruned [`SphereTree`] query, the triplet hulls only
+    /// where they can lower the value (`φ_s > −max r_temp` of the near-surface sources), and pairs
+    /// and triplets skipped when a bounding-ball lower bound cannot beat the current minimum. Every
+    /// skip is exact (a skipped term is provably not below the minimum, with a `1e−9 band` rounding
+    /// margin), so the result equals [`Self::value_exhaustive`] bitwise (tested on random sets).
     pub fn value(&self, q: &Pt3, h: f64) -> f64 {
+        let band = self.band(h);
+        if self.src.is_empty() {
+            return band;
+        }
+        if self.params.method == SurfaceMethod::ZhuBridson {
+            return self.value_exhaustive(q, h);
+        }
+        let eps = PRUNE_EPS * band;
+        let search = 2.0 * self.params.hull_l * self.r_max + band;
+        let phi_s = self.tree.min_value(q, search, band, eps);
+        if phi_s.is_nan() || phi_s.abs() > band {
+            return phi_s.clamp(-band, band);
+        }
+        match self.params.method {
+            SurfaceMethod::Hulls if phi_s > -self.near_r_max - eps => phi_s.min(self.hulls_pruned(q, phi_s, eps, None)),
+            _ => phi_s,
+        }
+    }
+
+    /// Reach of the hulls beyond the spheres (m): `δ = (4 l + 2)/3 · max r_temp` over the
+    /// near-surface sources. Every point of a valid pair or triplet hull lies within `δ` of the
+    /// union of its balls (take the vertex of largest barycentric weight `λ_k ≥ 1/3`: the centre
+    /// offset is `≤ (2/3)` of an edge `< 2 l r_max`, the radius change `≤ (2/3) r_max`), so the
+    /// hull value at any point is at least the sphere-union value minus `δ`.
+    pub fn hull_reach(&self) -> f64 {
+        (4.0 * self.params.hull_l + 2.0) / 3.0 * self.near_r_max
+    }
+
+    /// The node value used by [`level_set_on_nodes`]: [`Self::value`], except that the triplet
+    /// hulls are evaluated only where the sphere-union value `φ_s ≤ h + δ` ([`Self::hull_reach`];
+    /// per node, `δ` uses the largest radius among the `K` nearest near-surface sources, which
+    /// are the only ones the hulls are built from).
+    ///
+    /// Where they are skipped, the exact value is `≥ φ_s − δ > h`, so both values exceed the local
+    /// mesh size `h`: every node of a tet cut by the surface, of the first air layer and of the
+    /// liquid gets exactly the value of [`Self::value`]; farther air nodes keep `φ_s`, which differs
+    /// from the exact value by at most `δ` (both positive, same clamp). Tested in
+    /// `tests/surface_fast.rs`.
+    pub fn value_on_node(&self, q: &Pt3, h: f64) -> f64 {
+        let band = self.band(h);
+        if self.src.is_empty() || self.params.method != SurfaceMethod::Hulls {
+            return self.value(q, h);
+        }
+        let eps = PRUNE_EPS * band;
+        let search = 2.0 * self.params.hull_l * self.r_max + band;
+        let phi_s = self.tree.min_value(q, search, band, eps);
+        if phi_s.is_nan() || phi_s.abs() > band {
+            return phi_s.clamp(-band, band);
+        }
+        if phi_s > -self.near_r_max - eps && phi_s <= h + self.hull_reach() {
+            phi_s.min(self.hulls_pruned(q, phi_s, eps, Some(h)))
+        } else {
+            phi_s
+        }
+    }
+
+    /// The reference evaluation of [`Self::value`]: the sphere union over every source in the
+    /// search ball (k-d tree radius query) and every pair and triplet of the `K` nearest
+    /// near-surface sources, without pruning. Kept for tests and for the Zhu–Bridson method.
+    pub fn value_exhaustive(&self, q: &Pt3, h: f64) -> f64 {
         let band = self.band(h);
         if self.src.is_empty() {
             return band;
@@ -125,7 +206,8 @@ impl LevelSetSampler {
         let l = self.params.hull_l;
         let search = 2.0 * l * self.r_max + band;
         let mut buf = Vec::new();
-        self.all.within(q, search, &mut buf);
+        let all = self.all.get_or_init(|| KdTree::build(&self.src.iter().map(|s| s.x).collect::<Vec<_>>()));
+        all.within(q, search, &mut buf);
         let phi_s = buf.iter().map(|&i| {
             let s = &self.src[i as usize];
             (q - s.x).norm() - s.r
@@ -161,18 +243,47 @@ impl LevelSetSampler {
     }
 
     /// Union of spheres, round cones of connected pairs and valid triplet hulls among the `K`
-    /// nearest near-surface sources (spec §3.11.1–3.11.3).
+    /// nearest near-surface sources (spec §3.11.1–3.11.3), every shape evaluated (no pruning).
     fn hulls(&self, q: &Pt3) -> f64 {
+        self.hull_union(q, f64::INFINITY, 0.0, None, false)
+    }
+
+    /// [`Self::hull_union`] with pruning: see there.
+    fn hulls_pruned(&self, q: &Pt3, best0: f64, eps: f64, skip_above: Option<f64>) -> f64 {
+        self.hull_union(q, best0, eps, skip_above, true)
+    }
+
+    /// The union value of [`Self::hulls`], starting from the known upper bound `best0` (the
+    /// sphere-union value), with exact pruning when `prune`: a round cone lies in the ball of radius `|a − b|/2 + max(r_a, r_b)`
+    /// about the segment midpoint and a triplet hull in the ball `R + max r_k` about the centroid
+    /// (`R` = largest centroid-to-centre distance). Outside such a ball every candidate of the
+    /// shape (cone distance, valid facet value) is `≥` the distance to the ball, so the shape is
+    /// skipped when that positive bound, minus `eps`, is not below the current minimum.
+    ///
+    /// With `skip_above = Some(h)` the shapes are not evaluated at all when
+    /// `best0 > h + (4 l + 2)/3 · max r` over the `K` nearest sources (the local form of
+    /// [`Self::hull_reach`], valid because the hulls are built from exactly these sources), and
+    /// `best0` is returned ([`Self::value_on_node`]).
+    fn hull_union(&self, q: &Pt3, best0: f64, eps: f64, skip_above: Option<f64>, prune: bool) -> f64 {
         let mut knn = Vec::new();
         self.near.knn(q, self.params.neighbours as usize, &mut knn);
         let s: Vec<Source> = knn.iter().map(|&(j, _)| self.src[self.near_idx[j as usize] as usize]).collect();
         let k = s.len();
         let l = self.params.hull_l;
-        let mut best = f64::INFINITY;
+        if let Some(h) = skip_above {
+            let reach = (4.0 * l + 2.0) / 3.0 * s.iter().map(|a| a.r).fold(0.0, f64::max);
+            if best0 > h + reach {
+                return best0;
+            }
+        }
+        let mut best = best0;
         for a in &s {
             best = best.min((q - a.x).norm() - a.r);
         }
-        // Connectivity matrix (K ≤ 32, so a flat vector).
+        let skip = |lb: f64, best: f64| {
+            let lb = lb - eps;
+            prune && lb > 0.0 && lb >= best
+        };
         let mut conn = vec![false; k * k];
         for i in 0..k {
             for j in (i + 1)..k {
@@ -180,7 +291,10 @@ impl LevelSetSampler {
                 let d = (a.x - b.x).norm();
                 if d < l * (a.r + b.r) && d > 0.0 {
                     conn[i * k + j] = true;
-                    best = best.min(pair_distance(q, &a.x, &b.x, a.r, b.r));
+                    let mid = Pt3::from((a.x.coords + b.x.coords) * 0.5);
+                    if !skip((q - mid).norm() - 0.5 * d - a.r.max(b.r), best) {
+                        best = best.min(pair_distance(q, &a.x, &b.x, a.r, b.r));
+                    }
                 }
             }
         }
@@ -192,6 +306,11 @@ impl LevelSetSampler {
                 for m in (j + 1)..k {
                     if conn[i * k + m] && conn[j * k + m] {
                         let (a, b, c) = (&s[i], &s[j], &s[m]);
+                        let cen = Pt3::from((a.x.coords + b.x.coords + c.x.coords) / 3.0);
+                        let rad = (a.x - cen).norm().max((b.x - cen).norm()).max((c.x - cen).norm());
+                        if skip((q - cen).norm() - rad - a.r.max(b.r).max(c.r), best) {
+                            continue;
+                        }
                         if let Some(f) = facet_distance(q, &[a.x, b.x, c.x], &[a.r, b.r, c.r]) {
                             best = best.min(f);
                         }
@@ -241,15 +360,36 @@ pub fn node_edges(mesh: &TetMesh) -> Ragged<u32> {
 ///
 /// Only the non-ballistic particles contribute (`parts.flags`); `parts.phi` supplies the stored
 /// level set for the interior radii. Parallel per node, bitwise deterministic.
+///
+/// Node values come from [`LevelSetSampler::value_on_node`]: exact (equal to
+/// [`LevelSetSampler::value`]) wherever the value is `≤ h` (liquid, interface tets, first air
+/// layer); air nodes farther out may carry the sphere-union value, at most
+/// [`LevelSetSampler::hull_reach`] above the hull value. Mesh sizes and edges come from the mesh's
+/// caches (`node_h`, `node_nbrs`) when filled.
 pub fn level_set_on_nodes(mesh: &TetMesh, parts: &Particles, params: &SurfaceParams, walls: &Walls) -> Vec<f64> {
     let sampler = LevelSetSampler::new(parts, params, walls);
-    let h = node_sizes(mesh);
-    let mut phi: Vec<f64> = mesh.nodes.par_iter().zip(h.par_iter()).map(|(q, &hq)| sampler.value(q, hq)).collect();
-    let edges = node_edges(mesh);
+    let n = mesh.nodes.len();
+    // The mesh caches both (filled by `compute_geometry`); meshes built without it get them here.
+    let h_own;
+    let h: &[f64] = if mesh.node_h.len() == n {
+        &mesh.node_h
+    } else {
+        h_own = node_sizes(mesh);
+        &h_own
+    };
+    let mut phi: Vec<f64> =
+        mesh.nodes.par_iter().zip(h.par_iter()).map(|(q, &hq)| sampler.value_on_node(q, hq)).collect();
+    let edges_own;
+    let edges: &Ragged<u32> = if mesh.node_nbrs.len() == n {
+        &mesh.node_nbrs
+    } else {
+        edges_own = node_edges(mesh);
+        &edges_own
+    };
     let bands: Vec<f64> = h.iter().map(|&hq| sampler.band(hq)).collect();
-    redistance_interior(&mesh.nodes, &edges, &bands, &mut phi);
+    redistance_interior(&mesh.nodes, edges, &bands, &mut phi);
     if let Some(solid) = walls.node_in_solid {
-        extend_into_solids(&edges, solid, &mut phi);
+        extend_into_solids(edges, solid, &mut phi);
     }
     phi
 }

@@ -20,7 +20,9 @@ use std::time::Instant;
 use flip_tet::bcc::{tetrahedralize, TetMesh};
 use flip_tet::octree::{Octree, OctreeSpec};
 use flip_tet::particles::{ParticleFlags, Particles};
-use flip_tet::surface::{level_set_on_nodes, marching_tets, smooth_surface, SurfaceMethod, SurfaceParams, Walls};
+use flip_tet::surface::{
+    level_set_on_nodes, marching_tets, smooth_surface, LevelSetSampler, SurfaceMethod, SurfaceParams, Walls,
+};
 use geom_core::io::{obj, MeshOut};
 use geom_core::math::{Pt3, Vec3};
 use geom_core::mesh::TriMesh;
@@ -262,7 +264,36 @@ fn run_surface(ctx: &RunCtx) -> Result<Summary> {
         }
     }
     plot.write_png(&ctx.out_dir.join("flatness_profile.png"))?;
+    levelset_cost(&mesh, &parts, &sc.surface, &mut sum);
     Ok(sum)
+}
+
+/// The level set's fast node path against the exhaustive reference evaluation, both timed in the
+/// same run (so the ratio is meaningful on a loaded machine) on every k-th node: the node values
+/// before interior redistancing, `value_on_node` (pruned, what the simulator uses) vs
+/// `value_exhaustive` (every source in the search ball, every pair and triplet of the `K` nearest).
+/// Differences are allowed only at air nodes whose both values exceed the local mesh size.
+fn levelset_cost(mesh: &TetMesh, parts: &Particles, surface: &SurfaceParams, sum: &mut Summary) {
+    use rayon::prelude::*;
+    let params = SurfaceParams { method: SurfaceMethod::Hulls, ..surface.clone() };
+    let s = LevelSetSampler::new(parts, &params, &Walls::none());
+    // Every k-th node (at most ~50 000), so the exhaustive reference stays a small part of the run.
+    let k = mesh.nodes.len().div_ceil(50_000).max(1);
+    let sub: Vec<(Pt3, f64)> = mesh.nodes.iter().zip(&mesh.node_h).step_by(k).map(|(q, &h)| (*q, h)).collect();
+    let t0 = Instant::now();
+    let fast: Vec<f64> = sub.par_iter().map(|(q, h)| s.value_on_node(q, *h)).collect();
+    let t_fast = t0.elapsed().as_secs_f64();
+    let t0 = Instant::now();
+    let slow: Vec<f64> = sub.par_iter().map(|(q, h)| s.value_exhaustive(q, *h)).collect();
+    let t_slow = t0.elapsed().as_secs_f64();
+    let differ = fast.iter().zip(&slow).filter(|(a, b)| a.to_bits() != b.to_bits()).count();
+    let max_diff = fast.iter().zip(&slow).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    sum.set("levelset_fast_s", t_fast)
+        .set("levelset_exhaustive_s", t_slow)
+        .set("levelset_speedup_exhaustive_over_fast", t_slow / t_fast.max(1e-12))
+        .set_count("levelset_nodes_compared", sub.len() as u64)
+        .set_count("levelset_nodes_differing", differ as u64)
+        .set("levelset_max_abs_diff_over_r", max_diff / parts.r_max().max(1e-300));
 }
 
 /// Parameters of `flip-tet/fvm-vs-nodal`.

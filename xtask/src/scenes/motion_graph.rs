@@ -17,10 +17,10 @@ use geom_core::anim::synth::{library, Preset};
 use geom_core::anim::JointRole;
 use geom_core::io::{obj, MeshOut};
 use geom_core::math::{Planar, Vec3};
-use geom_core::rng::Rng;
 use motion_graph::{
-    assemble, enforce_body, evaluate, fix_contacts, smooth, BodyConstraint, ClipStats, Database, DbParams, FrameRef,
-    GraphParams, HardConstraint, JointConstraint, MotionGraph, Problem, Search, SearchParams, Tolerance, Weights,
+    assemble, enforce_body, evaluate, fix_contacts, random_mg1, smooth, BodyConstraint, ClipStats, Database, DbParams,
+    FrameRef, GraphParams, HardConstraint, JointConstraint, MotionGraph, Problem, Search, SearchParams, Tolerance,
+    Weights,
 };
 use serde::Deserialize;
 
@@ -155,40 +155,13 @@ fn load_db(spec: &DbSpec, mode: Mode) -> Result<Database> {
     mg(Database::from_motions(clips, &spec.params))
 }
 
-fn random_problems(
-    n: usize,
-    frames: u32,
-    inter: (usize, usize),
-    speed: f64,
-    dist_frac: (f64, f64),
-    seed: u64,
-    w: Weights,
-) -> Vec<Problem> {
-    let mut rng = Rng::new(seed);
-    (0..n)
-        .map(|_| {
-            let k = inter.0 + rng.below(inter.1.saturating_sub(inter.0) + 1);
-            let mut body = vec![BodyConstraint { time: 0, x: 0.0, z: 0.0, yaw: Some(0.0) }];
-            let (mut x, mut z, mut dir) = (0.0, 0.0, 0.0f64);
-            let mut t_prev = 0u32;
-            for i in 1..=k + 1 {
-                let t = if i == k + 1 {
-                    frames - 1
-                } else {
-                    (frames as f64 * i as f64 / (k + 1) as f64 + rng.range(-10.0, 10.0)) as u32
-                };
-                let dt = (t - t_prev) as f64 / 30.0;
-                let d = rng.range(dist_frac.0, dist_frac.1) * speed * dt;
-                dir += rng.range(-1.0, 1.0);
-                x += d * dir.sin();
-                z += d * dir.cos();
-                let yaw = if i == k + 1 { Some(dir) } else { None };
-                body.push(BodyConstraint { time: t, x, z, yaw });
-                t_prev = t;
-            }
-            Problem { length: Some(frames), body, weights: w, ..Default::default() }
-        })
-        .collect()
+/// CPU time (s) of the calling thread so far, from `/proc/thread-self/schedstat` (Linux; `None`
+/// elsewhere). The search is single-threaded, so the difference over a search is its time on an
+/// idle core: reported beside the wall-clock `search_s_*` because the machine is shared.
+fn thread_cpu_s() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
+    Some(ns * 1e-9)
 }
 
 fn fixed_problem(p: &ProblemSpec, g: &MotionGraph, w: Weights) -> Result<Problem> {
@@ -239,12 +212,14 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
     let stats = g.stats();
     let clip_stats = ClipStats::of(&g);
     let problems: Vec<Problem> = match &p.problems {
-        &Problems::Random { count, frames, intermediate, speed, dist_frac, seed } => random_problems(
+        &Problems::Random { count, frames, intermediate, speed, dist_frac, seed } => random_mg1(
             mode.pick(count.0, count.1, count.2),
             frames,
+            p.database.params.rate_hz,
             intermediate,
             speed,
             dist_frac,
+            1.0,
             seed,
             p.weights,
         ),
@@ -293,11 +268,16 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
     let mut positions_at: Vec<Option<Vec3>> = Vec::new();
     let mut residual_max: f64 = 0.0;
     let mut speeds = Vec::new();
+    let mut search_cpu_s = Vec::new();
     for (k, pb) in problems.iter().enumerate() {
         let t0 = Instant::now();
+        let cpu0 = thread_cpu_s();
         let sp = SearchParams { rng_seed: p.search.rng_seed.wrapping_add(k as u64), ..p.search.clone() };
         let mut s = match Search::new(&g, pb.clone(), sp.clone()) {
-            Ok(s) => s,
+            Ok(mut s) => {
+                s.stop_when(Some(p.tolerance));
+                s
+            }
             Err(e) => {
                 let why = e.to_string();
                 csv.row(
@@ -334,6 +314,9 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
         }
         let st = met_at.unwrap_or(t0.elapsed().as_secs_f64());
         search_s.push(st);
+        if let (Some(a), Some(b)) = (cpu0, thread_cpu_s()) {
+            search_cpu_s.push(b - a);
+        }
         let Some(best) = s.best().cloned() else { continue };
         let b0 = pb
             .body
@@ -434,6 +417,9 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
     sum.set_count("problems_solved", search_s.len() as u64);
     sum.set("search_s_median", percentile(&search_s, 50.0));
     sum.set("search_s_p90", percentile(&search_s, 90.0));
+    if search_cpu_s.len() == search_s.len() && !search_cpu_s.is_empty() {
+        sum.set("search_cpu_s_median", percentile(&search_cpu_s, 50.0));
+    }
     sum.set("constraint_err_m_p90_before", percentile(&err_before, 90.0));
     sum.set("constraint_err_m_p90_after", percentile(&err_after, 90.0));
     sum.set("residual_err_m_max", residual_max);

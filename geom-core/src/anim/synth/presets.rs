@@ -15,7 +15,9 @@ use std::f64::consts::PI;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Preset {
     /// The paper's football database: strong bias to running forward. Shares: 45 % run forward
-    /// (3–6 m/s, gentle curvature), 15 % run with sharp cuts (|κ| up to 1.2 1/m), 15 % walk
+    /// (3–6 m/s, gentle curvature), 15 % run with sharp cuts (|κ| up to 1.2 1/m; cruising at
+    /// 2.5–5 m/s, slowing into each cut to keep the lateral acceleration ≤ 6 m/s², never below
+    /// 2.3 m/s), 15 % walk
     /// (0.8–1.8 m/s), 5 % U-turn, 5 % jump, 5 % stand → start / stop → stand, 5 % pick-up, 5 %
     /// walk with a wave or reach.
     Football,
@@ -89,6 +91,13 @@ pub fn random_style(rng: &mut Rng) -> SynthStyle {
     }
 }
 
+/// Largest lateral acceleration `v² |κ|` of a run with sharp cuts (m/s², ≈ 0.6 g).
+const CUT_LATERAL_ACC: f64 = 6.0;
+
+/// Slowest speed a run with cuts slows to (m/s): the top of the walk → run hysteresis of
+/// §3.13.2 step 2, so the gait stays a run.
+const RUN_MIN_SPEED: f64 = 2.3;
+
 fn loco(secs: f64, speed: Profile, curvature: Profile) -> Behaviour {
     Behaviour::Locomote { secs, speed, curvature }
 }
@@ -106,14 +115,19 @@ fn behaviours(c: Class, d: f64, rng: &mut Rng) -> Vec<Behaviour> {
             b.push(loco(d + 1.0, Profile::linear(rng.range(3.0, 6.0), rng.range(3.0, 6.0)), p));
         }
         Class::RunCuts => {
+            // A runner slows into a sharp cut: the lateral acceleration `v² |κ|` is capped at
+            // `CUT_LATERAL_ACC` (≈ 0.6 g; taking |κ| = 1.2 1/m at 5 m/s would need 3 g), with the
+            // speed floored at `RUN_MIN_SPEED` so the gait stays a run. Between cuts the runner
+            // is back at the clip's cruising speed.
             let mut t = 0.0;
-            let v = rng.range(3.0, 5.0);
+            let v = rng.range(2.5, 5.0);
             while t < d + 1.0 {
                 let secs = rng.range(0.8, 1.8);
-                let k = sign(rng) * rng.range(0.4, 1.2);
+                let k: f64 = sign(rng) * rng.range(0.4, 1.2);
+                let vc = (CUT_LATERAL_ACC / k.abs()).sqrt().clamp(RUN_MIN_SPEED.min(v), v);
                 b.push(loco(
                     secs,
-                    Profile::constant(v),
+                    Profile { keys: vec![(0.0, v), (0.3, vc), (0.7, vc), (1.0, v)] },
                     Profile { keys: vec![(0.0, 0.0), (0.3, k), (0.7, k), (1.0, 0.0)] },
                 ));
                 t += secs;
