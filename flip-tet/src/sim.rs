@@ -332,25 +332,11 @@ pub fn nodal_phi_gradient(mesh: &TetMesh, phi: &[f64], wall_mask: u8) -> Vec<Vec
     (0..mesh.nodes.len())
         .into_par_iter()
         .map(|i| {
-            let (mut s, mut w) = (Vec3::zeros(), 0.0);
-            for &t in mesh.node_tets.row(i) {
-                let t = t as usize;
+            crate::transfer::ring_average(mesh, i, wall_mask, |t| {
                 let tv = mesh.tets[t];
-                let g = (0..4).fold(Vec3::zeros(), |acc, a| acc + mesh.grad_bary[t][a] * phi[tv[a] as usize]);
-                s += g * mesh.volume[t];
-                w += mesh.volume[t];
-            }
-            if w == 0.0 {
-                return Vec3::zeros();
-            }
-            let mut g = s / w;
-            let b = mesh.node_boundary[i] & wall_mask;
-            for a in 0..3 {
-                if b & (3 << (2 * a)) != 0 {
-                    g[a] = 0.0;
-                }
-            }
-            g
+                Some((0..4).fold(Vec3::zeros(), |acc, a| acc + mesh.grad_bary[t][a] * phi[tv[a] as usize]))
+            })
+            .unwrap_or_else(Vec3::zeros)
         })
         .collect()
 }

@@ -117,33 +117,38 @@ pub fn blend_weak(p2g: &TetVelocity, extrapolated: &mut [Vec3], p: &TransferPara
     }
 }
 
+/// Volume-weighted average at node `i` of `f(t)` over its incident tets where `f` gives a value;
+/// `None` when none does. At the closed box walls of `wall_mask` (bit `2a + side` as in
+/// `TetMesh::node_boundary`) the wall-normal component is removed (free slip for velocities,
+/// `∂φ/∂n = 0` for the mirrored level set).
+pub fn ring_average(mesh: &TetMesh, i: usize, wall_mask: u8, f: impl Fn(usize) -> Option<Vec3>) -> Option<Vec3> {
+    let (mut s, mut w) = (Vec3::zeros(), 0.0);
+    for &t in mesh.node_tets.row(i) {
+        let t = t as usize;
+        if let Some(x) = f(t) {
+            s += x * mesh.volume[t];
+            w += mesh.volume[t];
+        }
+    }
+    if w == 0.0 {
+        return None;
+    }
+    let mut v = s / w;
+    let b = mesh.node_boundary[i] & wall_mask;
+    for a in 0..3 {
+        if b & (3 << (2 * a)) != 0 {
+            v[a] = 0.0;
+        }
+    }
+    Some(v)
+}
+
 /// Volume-weighted nodal average of the valid tets around each node; `None` where no incident
-/// tet is valid. Free slip at the closed box walls of `wall_mask` (bit `2a + side` as in
-/// `TetMesh::node_boundary`): the wall-normal component is removed there.
+/// tet is valid. Free slip at the closed box walls of `wall_mask` (see [`ring_average`]).
 pub fn node_values(mesh: &TetMesh, u: &[Vec3], valid: &[bool], wall_mask: u8) -> Vec<Option<Vec3>> {
     (0..mesh.nodes.len())
         .into_par_iter()
-        .map(|i| {
-            let (mut s, mut w) = (Vec3::zeros(), 0.0);
-            for &t in mesh.node_tets.row(i) {
-                let t = t as usize;
-                if valid[t] {
-                    s += u[t] * mesh.volume[t];
-                    w += mesh.volume[t];
-                }
-            }
-            if w == 0.0 {
-                return None;
-            }
-            let mut v = s / w;
-            let b = mesh.node_boundary[i] & wall_mask;
-            for a in 0..3 {
-                if b & (3 << (2 * a)) != 0 {
-                    v[a] = 0.0;
-                }
-            }
-            Some(v)
-        })
+        .map(|i| ring_average(mesh, i, wall_mask, |t| valid[t].then(|| u[t])))
         .collect()
 }
 

@@ -28,6 +28,22 @@ impl BroadPhase {
         }
     }
 
+    /// Refits the trees to the given boxes, or builds them when there are none (first query or
+    /// after [`REBUILD_EVERY`] steps).
+    fn refit_or_build(&mut self, vbox: &[Aabb], tbox: &[Aabb], ebox: &[Aabb]) {
+        match &mut self.trees {
+            Some([v, t, e]) => {
+                v.refit(vbox);
+                t.refit(tbox);
+                e.refit(ebox);
+            }
+            None => {
+                self.trees = Some([AabbTree::build(vbox), AabbTree::build(tbox), AabbTree::build(ebox)]);
+                self.steps_since_build = 0;
+            }
+        }
+    }
+
     /// True once the trees exist (they are built on the first query).
     pub fn is_built(&self) -> bool {
         self.trees.is_some()
@@ -44,17 +60,7 @@ impl BroadPhase {
         tbox: &[Aabb],
         ebox: &[Aabb],
     ) -> (Pairs, Pairs) {
-        match &mut self.trees {
-            Some([v, t, e]) => {
-                v.refit(vbox);
-                t.refit(tbox);
-                e.refit(ebox);
-            }
-            None => {
-                self.trees = Some([AabbTree::build(vbox), AabbTree::build(tbox), AabbTree::build(ebox)]);
-                self.steps_since_build = 0;
-            }
-        }
+        self.refit_or_build(vbox, tbox, ebox);
         let [vt_tree, t_tree, e_tree] = self.trees.as_ref().expect("built just above");
         let mut vt = Vec::new();
         vt_tree.pairs_with(t_tree, |v, t| {
@@ -88,17 +94,7 @@ impl BroadPhase {
         changed: &[bool],
     ) -> (Pairs, Pairs) {
         let (vbox, tbox, ebox) = bx;
-        match &mut self.trees {
-            Some([v, t, e]) => {
-                v.refit(vbox);
-                t.refit(tbox);
-                e.refit(ebox);
-            }
-            None => {
-                self.trees = Some([AabbTree::build(vbox), AabbTree::build(tbox), AabbTree::build(ebox)]);
-                self.steps_since_build = 0;
-            }
-        }
+        self.refit_or_build(vbox, tbox, ebox);
         let [v_tree, t_tree, e_tree] = self.trees.as_ref().expect("built just above");
         let mut vt = Vec::new();
         for (v, b) in vbox.iter().enumerate().filter(|&(v, _)| changed[v]) {
