@@ -19,28 +19,14 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use geom_core::linalg::Csc;
 use geom_core::math::{Pt3, Vec3};
 use geom_core::mesh::subdivide_linear;
-use shells::{
-    Damping, DofMap, Effects, ImplicitSystem, IntegratorSettings, Material, MembraneLaw, ShellSceneDesc, ShellSim,
-    VelocitySolve,
-};
+use shells::{DofMap, Effects, ImplicitSystem, IntegratorSettings, ShellSceneDesc, ShellSim, VelocitySolve};
 use std::hint::black_box;
 use tracks::metrics::LowPass;
-use tracks::procedural::{bag_guide, xavier, xavier_guide, Xavier};
+use tracks::procedural::{bag_guide, xavier, xavier_guide, xavier_material, Xavier};
 use tracks::{
     build_test_functions, cluster, pg_mass_matrix, ClusterOptions, GuideAnimation, KktMethod, TestFunctionSpec,
     TestFunctions, TrackOptions, TrackingConstraints, TrackingSolver,
 };
-
-/// Xavier's cloth (`tracks/xavier` scene): 0.2 kg/m², Et = 3000 N/m, ν = 0.3.
-fn xavier_cloth() -> Material {
-    Material {
-        density: 0.2,
-        membrane: MembraneLaw::Isotropic { young_thickness: 3000.0, poisson: 0.3, compression_softening: None },
-        bending: 2e-5,
-        damping: Damping::Rayleigh { alpha: 0.0, beta: 5e-4 },
-        plasticity: None,
-    }
-}
 
 fn xavier_sim(x: &Xavier, guide: &GuideAnimation) -> ShellSim {
     let mut g0 = vec![Pt3::origin(); guide.n_vertices()];
@@ -51,7 +37,7 @@ fn xavier_sim(x: &Xavier, guide: &GuideAnimation) -> ShellSim {
         uv: None,
         initial: Some(g0),
         initial_velocity: None,
-        material: xavier_cloth(),
+        material: xavier_material(),
         effects: Effects { gravity: Some(Vec3::new(0.0, -9.81, 0.0)), ..Effects::default() },
         constraints: vec![],
         integrator: IntegratorSettings::default(),

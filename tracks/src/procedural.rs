@@ -206,6 +206,18 @@ pub struct Xavier {
     pub quality: (f64, f64),
 }
 
+/// Xavier's cloth (`tracks/xavier`, spec §6.4): 0.2 kg/m², Et = 3000 N/m, ν = 0.3, k_B = 2e-5 J,
+/// stiffness-proportional damping β = 5e-4 s.
+pub fn xavier_material() -> shells::Material {
+    shells::Material {
+        density: 0.2,
+        membrane: shells::MembraneLaw::Isotropic { young_thickness: 3000.0, poisson: 0.3, compression_softening: None },
+        bending: 2e-5,
+        damping: shells::Damping::Rayleigh { alpha: 0.0, beta: 5e-4 },
+        plasticity: None,
+    }
+}
+
 /// Builds the Xavier mesh and its rig data (spec §6.4): box surface 31 × 36 × 6 segments mapped
 /// to an X by ρ = max(|u|,|w|), φ = atan2(w, u), R(φ) = 0.50 + 0.77 sin²(2φ), then 10 Taubin
 /// passes (λ = 0.5, μ = −0.53).

@@ -85,10 +85,6 @@ fn vinyl() -> Material {
     iso_material(0.3, 5.0e3, 0.35, 5e-5, 5e-3)
 }
 
-fn xavier_cloth() -> Material {
-    iso_material(0.2, 3000.0, 0.3, 2e-5, 5e-4)
-}
-
 /// Gravity, the given obstacles and (optionally) self-collision; no wind.
 fn gravity_effects(self_collision: bool, obstacles: Vec<Obstacle>) -> Effects {
     let any_obstacle = !obstacles.is_empty();
@@ -729,7 +725,7 @@ pub(crate) fn xavier_setup(
         tracked_rest: x.mesh.clone(),
         desc: Box::new(move || ShellSceneDesc {
             initial: Some(g0.clone()),
-            ..shell_desc(&mesh, xavier_cloth(), xavier_effects(self_collision))
+            ..shell_desc(&mesh, tracks::procedural::xavier_material(), xavier_effects(self_collision))
         }),
         tf,
         fps: 30.0,
