@@ -45,16 +45,19 @@ impl Aabb {
     }
 
     /// `true` if the box holds no point (some `min > max`, or a NaN bound).
+    #[inline]
     pub fn is_empty(&self) -> bool {
         !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)
     }
 
     /// The smallest box holding both boxes.
+    #[inline]
     pub fn union(&self, other: &Aabb) -> Aabb {
         Aabb { min: self.min.inf(&other.min), max: self.max.sup(&other.max) }
     }
 
     /// Grows the box to hold `p`.
+    #[inline]
     pub fn extend(&mut self, p: &Pt3) {
         self.min = self.min.inf(p);
         self.max = self.max.sup(p);
@@ -62,22 +65,26 @@ impl Aabb {
 
     /// The box grown by `margin` on every side (a negative margin shrinks it; the result may be
     /// empty). The empty box stays empty.
+    #[inline]
     pub fn grow(&self, margin: f64) -> Aabb {
         let m = Vec3::repeat(margin);
         Aabb { min: self.min - m, max: self.max + m }
     }
 
     /// `true` if `p` lies in the closed box.
+    #[inline]
     pub fn contains(&self, p: &Pt3) -> bool {
         (0..3).all(|k| self.min[k] <= p[k] && p[k] <= self.max[k])
     }
 
     /// `true` if the closed boxes share a point (touching boxes overlap). Exact: only comparisons.
+    #[inline]
     pub fn overlaps(&self, other: &Aabb) -> bool {
         (0..3).all(|k| self.min[k] <= other.max[k] && other.min[k] <= self.max[k])
     }
 
     /// Length of the diagonal, 0 for the empty box.
+    #[inline]
     pub fn diag(&self) -> f64 {
         if self.is_empty() {
             0.0
@@ -87,6 +94,7 @@ impl Aabb {
     }
 
     /// Side lengths (zero vector for the empty box).
+    #[inline]
     pub fn size(&self) -> Vec3 {
         if self.is_empty() {
             Vec3::zeros()

@@ -1,15 +1,16 @@
 //! Broad phase (shells.md §3.9): geom-core [`AabbTree`]s over the swept, inflated boxes of the
 //! cloth's vertices, triangles and edges. The trees are built once, refitted on every query (O(n))
 //! and rebuilt every [`REBUILD_EVERY`] steps, when refitted boxes have drifted far from the
-//! build-time layout. Candidate pairs come out sorted and deduplicated, so everything downstream
-//! runs in a fixed order (deterministic for any thread count).
+//! build-time layout. Candidate pairs come out without duplicates in the trees' fixed traversal
+//! order (deterministic for any thread count); callers sort what they keep (the few hits)
+//! rather than every candidate.
 
 use geom_core::spatial::{Aabb, AabbTree};
 
 /// Steps between full rebuilds of the trees (refit in between; spec §3.9).
 pub const REBUILD_EVERY: u32 = 50;
 
-/// Sorted index pairs.
+/// Index pairs (unique, in a deterministic but unspecified order).
 pub type Pairs = Vec<(u32, u32)>;
 
 /// Vertex, triangle and edge trees with their refit/rebuild bookkeeping.
@@ -49,8 +50,8 @@ impl BroadPhase {
         self.trees.is_some()
     }
 
-    /// Candidate (vertex, triangle) and (edge, edge) pairs whose boxes overlap, sorted, without
-    /// pairs that share a vertex. `vbox`, `tbox`, `ebox` are the boxes of the vertices, of
+    /// Candidate (vertex, triangle) and (edge, edge) pairs whose boxes overlap, each once (edge
+    /// pairs as (e, f) with e < f), without pairs that share a vertex, in traversal order. `vbox`, `tbox`, `ebox` are the boxes of the vertices, of
     /// `tris` and of `edges`; their lengths must not change between calls.
     pub fn candidate_pairs(
         &mut self,
@@ -62,22 +63,29 @@ impl BroadPhase {
     ) -> (Pairs, Pairs) {
         self.refit_or_build(vbox, tbox, ebox);
         let [vt_tree, t_tree, e_tree] = self.trees.as_ref().expect("built just above");
-        let mut vt = Vec::new();
-        vt_tree.pairs_with(t_tree, |v, t| {
-            if !tris[t as usize].contains(&v) {
-                vt.push((v, t));
-            }
-        });
-        vt.sort_unstable();
-        let mut ee = Vec::new();
-        e_tree.self_pairs(|e, f| {
-            let (ea, eb) = (edges[e as usize], edges[f as usize]);
-            if !eb.contains(&ea[0]) && !eb.contains(&ea[1]) {
-                ee.push((e, f));
-            }
-        });
-        ee.sort_unstable();
-        (vt, ee)
+        // The two traversals are independent: run them side by side (each list is produced by
+        // one sequential traversal, so the result does not depend on the thread count).
+        rayon::join(
+            || {
+                let mut vt = Vec::new();
+                vt_tree.pairs_with(t_tree, |v, t| {
+                    if !tris[t as usize].contains(&v) {
+                        vt.push((v, t));
+                    }
+                });
+                vt
+            },
+            || {
+                let mut ee = Vec::new();
+                e_tree.self_pairs(|e, f| {
+                    let (ea, eb) = (edges[e as usize], edges[f as usize]);
+                    if !eb.contains(&ea[0]) && !eb.contains(&ea[1]) {
+                        ee.push((e, f));
+                    }
+                });
+                ee
+            },
+        )
     }
 }
 
@@ -85,7 +93,10 @@ impl BroadPhase {
     /// The candidate pairs of [`BroadPhase::candidate_pairs`] that involve at least one vertex
     /// with `changed[v]`, found by refitting the trees and querying only the boxes of changed
     /// vertices, of triangles and of edges with a changed vertex (same boxes, same closed-box
-    /// overlap test, hence exactly the subset of the full list; sorted, deduplicated).
+    /// overlap test, hence exactly the subset of the full list, each pair once, edge pairs as
+    /// (e, f) with e < f; in query order). A pair reachable from several changed primitives is
+    /// kept only from the first of them in a fixed rule (vertex boxes before triangle boxes; the
+    /// smaller edge index), so no sorting or deduplication is needed.
     pub fn candidate_pairs_touching(
         &mut self,
         tris: &[[u32; 3]],
@@ -96,41 +107,49 @@ impl BroadPhase {
         let (vbox, tbox, ebox) = bx;
         self.refit_or_build(vbox, tbox, ebox);
         let [v_tree, t_tree, e_tree] = self.trees.as_ref().expect("built just above");
-        let mut vt = Vec::new();
-        for (v, b) in vbox.iter().enumerate().filter(|&(v, _)| changed[v]) {
-            let v = v as u32;
-            t_tree.query(b, |t| {
-                if !tris[t as usize].contains(&v) {
-                    vt.push((v, t));
+        // Vertex–triangle and edge–edge queries side by side (each list sequential, so the
+        // result does not depend on the thread count).
+        let vt_part = || {
+            let mut vt = Vec::new();
+            for (v, b) in vbox.iter().enumerate().filter(|&(v, _)| changed[v]) {
+                let v = v as u32;
+                t_tree.query(b, |t| {
+                    if !tris[t as usize].contains(&v) {
+                        vt.push((v, t));
+                    }
+                });
+            }
+            for (t, tri) in tris.iter().enumerate() {
+                if tri.iter().any(|&i| changed[i as usize]) {
+                    v_tree.query(&tbox[t], |v| {
+                        // Changed vertices found this pair from their own box above.
+                        if !changed[v as usize] && !tri.contains(&v) {
+                            vt.push((v, t as u32));
+                        }
+                    });
                 }
-            });
-        }
-        for (t, tri) in tris.iter().enumerate() {
-            if tri.iter().any(|&i| changed[i as usize]) {
-                v_tree.query(&tbox[t], |v| {
-                    if !tri.contains(&v) {
-                        vt.push((v, t as u32));
-                    }
-                });
             }
-        }
-        vt.sort_unstable();
-        vt.dedup();
-        let mut ee = Vec::new();
-        for (e, ea) in edges.iter().enumerate() {
-            if ea.iter().any(|&i| changed[i as usize]) {
-                e_tree.query(&ebox[e], |f| {
-                    let eb = edges[f as usize];
-                    if f as usize != e && !eb.contains(&ea[0]) && !eb.contains(&ea[1]) {
-                        let e = e as u32;
-                        ee.push((e.min(f), e.max(f)));
-                    }
-                });
+            vt
+        };
+        let ee_part = || {
+            let touches = |e: &[u32; 2]| e.iter().any(|&i| changed[i as usize]);
+            let mut ee = Vec::new();
+            for (e, ea) in edges.iter().enumerate() {
+                if touches(ea) {
+                    e_tree.query(&ebox[e], |f| {
+                        let eb = edges[f as usize];
+                        // A pair of two changed edges is kept from its smaller index only.
+                        let first = !touches(&eb) || (f as usize) > e;
+                        if first && f as usize != e && !eb.contains(&ea[0]) && !eb.contains(&ea[1]) {
+                            let e = e as u32;
+                            ee.push((e.min(f), e.max(f)));
+                        }
+                    });
+                }
             }
-        }
-        ee.sort_unstable();
-        ee.dedup();
-        (vt, ee)
+            ee
+        };
+        rayon::join(vt_part, ee_part)
     }
 }
 
@@ -154,7 +173,13 @@ mod tests {
             let vb: Vec<Aabb> = pts.iter().map(|p| Aabb::from_points(&[*p]).grow(0.05)).collect();
             let tb: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(&t.map(|i| pts[i as usize]))).collect();
             let eb: Vec<Aabb> = edges.iter().map(|e| Aabb::from_points(&e.map(|i| pts[i as usize]))).collect();
-            let (vt, ee) = bp.candidate_pairs(&tris, &edges, &vb, &tb, &eb);
+            let (mut vt, mut ee) = bp.candidate_pairs(&tris, &edges, &vb, &tb, &eb);
+            let (nvt, nee) = (vt.len(), ee.len());
+            vt.sort_unstable();
+            vt.dedup();
+            ee.sort_unstable();
+            ee.dedup();
+            assert_eq!((vt.len(), ee.len()), (nvt, nee), "round {round}: duplicates");
             let mut bvt = Vec::new();
             for (v, b) in vb.iter().enumerate() {
                 for (t, c) in tb.iter().enumerate() {
@@ -176,7 +201,13 @@ mod tests {
             assert_eq!(ee, bee, "round {round}");
             // The changed-vertex subset equals the full list filtered to pairs touching them.
             let changed: Vec<bool> = (0..n).map(|i| i % 7 == round).collect();
-            let (svt, see) = bp.candidate_pairs_touching(&tris, &edges, (&vb, &tb, &eb), &changed);
+            let (mut svt, mut see) = bp.candidate_pairs_touching(&tris, &edges, (&vb, &tb, &eb), &changed);
+            let (nvt, nee) = (svt.len(), see.len());
+            svt.sort_unstable();
+            svt.dedup();
+            see.sort_unstable();
+            see.dedup();
+            assert_eq!((svt.len(), see.len()), (nvt, nee), "round {round}: duplicates in the subset");
             let c = |i: u32| changed[i as usize];
             let fvt: Vec<_> =
                 bvt.iter().copied().filter(|&(v, t)| c(v) || tris[t as usize].iter().any(|&i| c(i))).collect();
