@@ -21,9 +21,18 @@
 //! The complete paths are scored with [`crate::path::score`] and enter the population; the
 //! randomized search (§3.8) refines them.
 //!
+//! Two additions keep curved approaches that the interpolated guide point ranks down (session
+//! 6; the MG-1 study in the README found every first constraint reachable without a cut while
+//! the beam missed it by 0.5 m): half of every beam is chosen by a *projection rank* (the kept
+//! terms plus the exact error at the next body constraint if the state stays in its clip until
+//! then), and half of the start frames are *aimed*: the frames whose own clip, uncut, comes
+//! closest to the first body constraint ([`GuidedParams::aimed_starts`]). [`guided_regrow`]
+//! runs the same beam from kept prefixes of population paths (a large-neighbourhood mutation).
+//!
 //! Cost: `O(#checkpoints · width · (edges per piece + draws²))` placements of two planar
 //! transforms each — a few tens of milliseconds for MG-1 (300 frames, 18k database frames).
 
+use crate::eval::place_r;
 use crate::graph::{EdgeId, FrameRef, MotionGraph};
 use crate::path::{hard_ok, score, Compiled, Hard, Path, Scored};
 use crate::rigid::Rigid2;
@@ -69,6 +78,24 @@ pub struct GuidedParams {
     /// drawn uniformly among them when there are more (0 = always all; at a hard constraint
     /// always all). Default 0.
     pub one_cut_draws: usize,
+    /// Regrow (ours): every this many search iterations (0 = never), the best paths of the
+    /// population are kept up to a constraint before the worst-met one and the rest is searched
+    /// again by the beam ([`guided_regrow`]). Default 2.
+    pub regrow_every: usize,
+    /// Share of the beam chosen by the *projection* rank (ours): the kept terms plus the error at
+    /// the next body constraint if the state stays in its clip until then (no cut; states whose
+    /// clip ends earlier have none). The rest is chosen by the rank of the module docs. Keeps
+    /// states that "coast" to the next constraint, which the interpolated guide point ranks
+    /// down when their path is curved. Default 0.5.
+    pub projection_share: f64,
+    /// Width of the first beam of a search (0 = `width`): one wide beam at the start finds
+    /// much better first paths than the narrow ones run during the search. Default 0.
+    pub initial_width: usize,
+    /// Aimed starts (ours): this fraction of the start states are the database frames whose own
+    /// clip, played on without a cut from the placed start, comes closest to the first body
+    /// constraint (every frame is tried; at most 1/16 of them from one clip); the rest are
+    /// random. Default 0.5.
+    pub aimed_starts: f64,
 }
 
 impl Default for GuidedParams {
@@ -86,6 +113,10 @@ impl Default for GuidedParams {
             guide_slack: 0.5,
             every: 2,
             one_cut_draws: 0,
+            regrow_every: 2,
+            projection_share: 0.5,
+            initial_width: 0,
+            aimed_starts: 0.5,
         }
     }
 }
@@ -106,6 +137,8 @@ struct Checkpoint {
     /// Interpolated target `(x, z)` when no body constraint sits here, and the radius around it
     /// that costs nothing in the ranking (`guide_slack` × distance left to the next target).
     guide: Option<(f64, f64, f64)>,
+    /// Time and index of the next body constraint after this checkpoint (projection rank).
+    next_body: Option<(u32, usize)>,
     last: bool,
 }
 
@@ -131,6 +164,8 @@ struct State {
 /// A ranked extension of a beam state to the next checkpoint.
 struct Ext {
     rank: f64,
+    /// Projection rank (see [`GuidedParams::projection_share`]).
+    rank2: f64,
     acc: f64,
     racc: f64,
     parent: usize,
@@ -242,6 +277,7 @@ fn checkpoints(g: &MotionGraph, cp: &Compiled, gp: &GuidedParams) -> Vec<Checkpo
                     .unwrap_or_default(),
                 hops: None,
                 guide,
+                next_body: body.iter().find(|b| b.0 > t).copied(),
                 last: t == last,
             }
         })
@@ -289,7 +325,7 @@ impl Beam<'_> {
         ta: u32,
         w: &Rigid2,
         jitter: f64,
-    ) -> Option<(f64, f64, f64, u32)> {
+    ) -> Option<(f64, f64, f64, f64, u32)> {
         let f = a + (c.t - ta);
         if f >= self.g.clip_len(clip) || (c.last && f + 1 < a + self.minp) {
             return None;
@@ -322,10 +358,24 @@ impl Beam<'_> {
             let d = ((wt.x - x).powi(2) + (wt.z - z).powi(2)).sqrt();
             self.gp.guide_weight * self.cp.w_p * (d - r).max(0.0).powi(2)
         });
+        // Projection rank: stay in the clip until the next body constraint.
+        let mut rank2 = f64::INFINITY;
+        if let Some((tn, i)) = c.next_body {
+            let fp = f + (tn - c.t);
+            if fp < self.g.clip_len(clip) {
+                let wp = w.compose(&self.g.torso_r(clip, fp));
+                let b = &self.cp.pb.body[i];
+                let dy = b.yaw.map_or(0.0, |y| wrap_angle(wp.yaw - y));
+                rank2 = racc
+                    + self.cp.w_p * ((wp.x - b.x).powi(2) + (wp.z - b.z).powi(2))
+                    + self.cp.w_o * dy * dy
+                    + 1e-6 * jitter;
+            }
+        }
         if let Some(h) = &c.hops {
             guide += HOP_PENALTY * h[clip as usize].min(1000) as f64;
         }
-        Some((acc, racc, racc + guide + 1e-6 * jitter, f))
+        Some((acc, racc, racc + guide + 1e-6 * jitter, rank2, f))
     }
 
     /// Range `[lo, hi)` of `out_leaf[clip]` leaving at frames `from ≤ i ≤ to`.
@@ -349,9 +399,10 @@ impl Beam<'_> {
         let cost = |e: EdgeId| self.cp.pb.weights.cut * g.edges[e as usize].cost as f64;
         let plus = |x: f64| (s.acc + x, s.racc + x);
         // 0 cuts: stay in the piece.
-        if let Some((acc, racc, rank, frame)) = self.eval(c, plus(0.0), s.clip, s.a, s.ta, &s.w, rng.f64()) {
+        if let Some((acc, racc, rank, rank2, frame)) = self.eval(c, plus(0.0), s.clip, s.a, s.ta, &s.w, rng.f64()) {
             out.push(Ext {
                 rank,
+                rank2,
                 acc,
                 racc,
                 parent: si,
@@ -372,8 +423,8 @@ impl Beam<'_> {
         // (dense graphs).
         let one = |e: EdgeId, out: &mut Vec<Ext>, jitter: f64| {
             let (clip, a, ta, w) = self.follow(e, s.a, s.ta, &s.w);
-            if let Some((acc, racc, rank, frame)) = self.eval(c, plus(cost(e)), clip, a, ta, &w, jitter) {
-                out.push(Ext { rank, acc, racc, parent: si, fill: [e, 0], n: 1, clip, a, ta, w, frame });
+            if let Some((acc, racc, rank, rank2, frame)) = self.eval(c, plus(cost(e)), clip, a, ta, &w, jitter) {
+                out.push(Ext { rank, rank2, acc, racc, parent: si, fill: [e, 0], n: 1, clip, a, ta, w, frame });
             }
         };
         let n1 = hi1 - lo1;
@@ -403,10 +454,23 @@ impl Beam<'_> {
                     for &e2 in es[lo..].iter().take_while(|e| fr(e) <= hi2) {
                         let (clip, a, ta, w) = self.follow(e2, a1, t1, &w1);
                         let jit = rng.f64();
-                        if let Some((acc, racc, rank, frame)) =
+                        if let Some((acc, racc, rank, rank2, frame)) =
                             self.eval(c, plus(cost(e1) + cost(e2)), clip, a, ta, &w, jit)
                         {
-                            out.push(Ext { rank, acc, racc, parent: si, fill: [e1, e2], n: 2, clip, a, ta, w, frame });
+                            out.push(Ext {
+                                rank,
+                                rank2,
+                                acc,
+                                racc,
+                                parent: si,
+                                fill: [e1, e2],
+                                n: 2,
+                                clip,
+                                a,
+                                ta,
+                                w,
+                                frame,
+                            });
                         }
                     }
                 }
@@ -429,9 +493,10 @@ impl Beam<'_> {
             }
             let take = |e2: EdgeId, out: &mut Vec<Ext>, jitter: f64| {
                 let (clip, a, ta, w) = self.follow(e2, a1, t1, &w1);
-                if let Some((acc, racc, rank, frame)) = self.eval(c, plus(cost(e1) + cost(e2)), clip, a, ta, &w, jitter)
+                if let Some((acc, racc, rank, rank2, frame)) =
+                    self.eval(c, plus(cost(e1) + cost(e2)), clip, a, ta, &w, jitter)
                 {
-                    out.push(Ext { rank, acc, racc, parent: si, fill: [e1, e2], n: 2, clip, a, ta, w, frame });
+                    out.push(Ext { rank, rank2, acc, racc, parent: si, fill: [e1, e2], n: 2, clip, a, ta, w, frame });
                 }
             };
             if c.hard.is_some() {
@@ -479,15 +544,16 @@ pub(crate) fn guided_seeds(
             if long.is_empty() {
                 return Err("every clip is shorter than a piece".into());
             }
-            (0..width * gp.start_factor.max(1))
-                .map(|_| {
-                    let c = long[rng.below(long.len())];
-                    FrameRef { clip: c, frame: rng.below((g.clip_len(c) - minp + 1) as usize) as u32 }
-                })
-                .collect()
+            let n = width * gp.start_factor.max(1);
+            let mut starts = aimed_starts(g, cp, minp, (gp.aimed_starts.clamp(0.0, 1.0) * n as f64) as usize);
+            while starts.len() < n {
+                let c = long[rng.below(long.len())];
+                starts.push(FrameRef { clip: c, frame: rng.below((g.clip_len(c) - minp + 1) as usize) as u32 });
+            }
+            starts
         }
     };
-    let mut beam: Vec<State> = starts
+    let beam: Vec<State> = starts
         .into_iter()
         .map(|s| State {
             start: s,
@@ -502,69 +568,403 @@ pub(crate) fn guided_seeds(
         })
         .collect();
     let ctx = Beam { g, cp, gp, minp };
-    let mut exts = Vec::new();
-    for c in checkpoints(g, cp, gp) {
-        exts.clear();
-        for (si, s) in beam.iter().enumerate() {
-            ctx.extend(si, s, &c, rng, &mut exts);
+    ctx.run(beam, checkpoints(g, cp, gp), width, rng)
+}
+
+/// Indices of up to `n` extensions with the smallest `key` (finite only), skipping `(clip, frame)`
+/// pairs in `seen` and parents that already have `per_parent` children; updates both. Only a
+/// prefix of the order is needed, so the best `PREFIX × n` are selected first and the rest is
+/// sorted only if that prefix runs out.
+fn take_best(
+    exts: &[Ext],
+    key: impl Fn(&Ext) -> f64,
+    n: usize,
+    per_parent: usize,
+    seen: &mut HashSet<(u32, u32)>,
+    children: &mut [usize],
+) -> Vec<usize> {
+    let mut out = Vec::with_capacity(n);
+    if n == 0 {
+        return out;
+    }
+    let mut order: Vec<(f64, u32)> =
+        exts.iter().enumerate().map(|(i, x)| (key(x), i as u32)).filter(|k| k.0.is_finite()).collect();
+    let cmp = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    let pre = (PREFIX * n).min(order.len());
+    if pre < order.len() {
+        order.select_nth_unstable_by(pre, cmp);
+    }
+    order[..pre].sort_unstable_by(cmp);
+    let mut sorted_rest = pre == order.len();
+    for pos in 0..order.len() {
+        if out.len() == n {
+            break;
         }
-        if exts.is_empty() {
-            return Err(format!("guided seeds: no path reaches frame {}", c.t));
+        if pos == pre && !sorted_rest {
+            order[pre..].sort_unstable_by(cmp);
+            sorted_rest = true;
         }
-        // Rank order of the extensions: only a prefix is needed (the beam takes `width`, at
-        // most `per_parent` per state), so select the best `PREFIX × width` first and sort the
-        // rest only if the prefix runs out.
-        let mut order: Vec<(f64, u32)> = exts.iter().enumerate().map(|(i, x)| (x.rank, i as u32)).collect();
-        let cmp = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-        let pre = (PREFIX * width).min(order.len());
-        if pre < order.len() {
-            order.select_nth_unstable_by(pre, cmp);
+        let i = order[pos].1 as usize;
+        let x = &exts[i];
+        if children[x.parent] >= per_parent.max(1) || !seen.insert((x.clip, x.frame)) {
+            continue;
         }
-        order[..pre].sort_unstable_by(cmp);
-        let mut sorted_rest = pre == order.len();
-        let mut seen = HashSet::new();
-        let mut children = vec![0usize; beam.len()];
-        let mut next = Vec::with_capacity(width);
-        let mut pos = 0;
-        while pos < order.len() {
-            if next.len() == width {
-                break;
-            }
-            if pos == pre && !sorted_rest {
-                order[pre..].sort_unstable_by(cmp);
-                sorted_rest = true;
-            }
-            let x = &exts[order[pos].1 as usize];
-            pos += 1;
-            if children[x.parent] >= gp.per_parent.max(1) || !seen.insert((x.clip, x.frame)) {
+        children[x.parent] += 1;
+        out.push(i);
+    }
+    out
+}
+
+/// Up to `n` start frames whose clip, played on without a cut from the start placement, comes
+/// closest to the first body constraint after time 0 (`w_p e² + w_o Δyaw²`), at most
+/// `max(1, n/16)` per clip. Every database frame is tried: one placement each.
+fn aimed_starts(g: &MotionGraph, cp: &Compiled, minp: u32, n: usize) -> Vec<FrameRef> {
+    let last = cp.target.saturating_sub(1);
+    let Some(b) = cp.pb.body.iter().filter(|b| b.time > 0).min_by_key(|b| b.time) else { return Vec::new() };
+    let t1 = b.time.min(last);
+    // The first piece must keep `minp` frames; staying until t1 keeps t1 + 1.
+    if n == 0 || t1 == 0 || t1 + 1 < minp {
+        return Vec::new();
+    }
+    let mut all: Vec<(f64, FrameRef)> = Vec::new();
+    for c in 0..g.db.clips.len() as u32 {
+        let len = g.clip_len(c);
+        for f in 0..len.saturating_sub(t1) {
+            let w0 = cp.start_r.compose(&g.torso_r(c, f).inverse());
+            let wt = w0.compose(&g.torso_r(c, f + t1));
+            let e2 = (wt.x - b.x).powi(2) + (wt.z - b.z).powi(2);
+            let dy = b.yaw.map_or(0.0, |y| wrap_angle(wt.yaw - y));
+            all.push((cp.w_p * e2 + cp.w_o * dy * dy, FrameRef { clip: c, frame: f }));
+        }
+    }
+    all.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.clip.cmp(&b.1.clip)).then(a.1.frame.cmp(&b.1.frame)));
+    let cap = (n / 16).max(1);
+    let mut per_clip = vec![0usize; g.db.clips.len()];
+    let mut out = Vec::with_capacity(n);
+    for (_, f) in all {
+        if out.len() == n {
+            break;
+        }
+        if per_clip[f.clip as usize] < cap {
+            per_clip[f.clip as usize] += 1;
+            out.push(f);
+        }
+    }
+    out
+}
+
+/// Landing paths (ours): for the first hard constraint at `t_h > 0` that has a body constraint
+/// at the same time, every path of one leaf cut `(s, i) → (c, j)` that plays a matching frame
+/// `f` at `t_h` (start frame `s = i + 1 − (t_h − (f − j))` of the first clip, both pieces at
+/// least `min_piece` long), ranked by the body-constraint terms at `t_h`; the best `n`, each
+/// ending at `t_h` (to be continued by [`guided_regrow`] with `t_cut = t_h`). Enumerated per
+/// edge into a clip holding a matching frame, over the matching frames: no start-frame loop.
+pub(crate) fn landing_paths(g: &MotionGraph, cp: &Compiled, min_piece: u32, n: usize) -> Vec<Path> {
+    let minp = min_piece.max(1);
+    let Some(&(th, h)) = cp.hard.iter().find(|x| x.0 > 0) else { return Vec::new() };
+    let body: Vec<&crate::problem::BodyConstraint> = cp.pb.body.iter().filter(|b| b.time == th).collect();
+    if body.is_empty() || n == 0 {
+        return Vec::new();
+    }
+    // Matching frames per clip.
+    let matching: Vec<Vec<u32>> = (0..g.db.clips.len() as u32)
+        .map(|c| (0..g.clip_len(c)).filter(|&f| hard_ok(g, &h, FrameRef { clip: c, frame: f })).collect())
+        .collect();
+    let mut all: Vec<(f64, Path)> = Vec::new();
+    for (e, nd) in g.edges.iter().enumerate() {
+        if !nd.is_leaf() || matching[nd.to.clip as usize].is_empty() {
+            continue;
+        }
+        let (i, j) = (nd.from.frame, nd.to.frame);
+        for &f in &matching[nd.to.clip as usize] {
+            // The second piece [j, f] plays from t_in = t_h − (f − j); the first [s, i] has
+            // t_in frames.
+            if f + 1 < j + minp || f - j >= th {
                 continue;
             }
-            children[x.parent] += 1;
-            let p = &beam[x.parent];
-            let mut cuts = p.cuts.clone();
-            cuts.extend_from_slice(&x.fill[..x.n as usize]);
-            let min_from = if x.n == 0 { p.min_from.max(x.frame) } else { (x.a + minp - 1).max(x.frame) };
-            next.push(State {
-                start: p.start,
-                cuts,
-                clip: x.clip,
-                a: x.a,
-                ta: x.ta,
-                w: x.w,
-                min_from,
-                acc: x.acc,
-                racc: x.racc,
-            });
+            let t_in = th - (f - j);
+            if t_in < minp || t_in > i + 1 {
+                continue;
+            }
+            let s0 = i + 1 - t_in;
+            let w = cp.start_r.compose(&g.torso_r(nd.from.clip, s0).inverse()).compose(&g.delta[e]);
+            let wt = w.compose(&g.torso_r(nd.to.clip, f));
+            let mut cost = cp.pb.weights.cut * nd.cost as f64;
+            for b in &body {
+                let dy = b.yaw.map_or(0.0, |y| wrap_angle(wt.yaw - y));
+                cost += cp.w_p * ((wt.x - b.x).powi(2) + (wt.z - b.z).powi(2)) + cp.w_o * dy * dy;
+            }
+            all.push((
+                cost,
+                Path { start: FrameRef { clip: nd.from.clip, frame: s0 }, cuts: vec![e as EdgeId], end_frame: f },
+            ));
         }
-        beam = next;
     }
-    let mut out: Vec<Scored> = beam
-        .into_iter()
-        .filter_map(|s| {
-            let end_frame = s.a + (cp.target - 1 - s.ta);
-            score(g, cp, &Path { start: s.start, cuts: s.cuts, end_frame }, minp)
-        })
-        .collect();
-    out.sort_by(|a, b| a.score.total_cmp(&b.score));
-    Ok(out)
+    let cmp = |a: &(f64, Path), b: &(f64, Path)| {
+        a.0.total_cmp(&b.0).then(a.1.start.clip.cmp(&b.1.start.clip)).then(a.1.cuts.cmp(&b.1.cuts))
+    };
+    if all.len() > n {
+        all.select_nth_unstable_by(n, cmp);
+        all.truncate(n);
+    }
+    all.sort_unstable_by(cmp);
+    all.into_iter().map(|x| x.1).collect()
+}
+
+/// Regrown paths (ours, a large-neighbourhood mutation in the spirit of §3.8's *replace*): each
+/// of `paths` is kept up to output time `t_cut` (its piece holding `t_cut` may only be left at or
+/// after the frame played then) and the rest is searched again by the beam over the checkpoints
+/// after `t_cut`, ranked as in [`guided_seeds`] with the kept prefix's terms included. Focusing
+/// the whole beam on the part of the problem after a constraint that is already met finds
+/// continuations a beam from scratch (which must also get the prefix right) rarely keeps.
+/// Up to `width` paths, best first; `Err` when no state reaches some checkpoint.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn guided_regrow(
+    g: &MotionGraph,
+    cp: &Compiled,
+    gp: &GuidedParams,
+    min_piece: u32,
+    width: usize,
+    paths: &[&Path],
+    t_cut: u32,
+    rng: &mut Rng,
+) -> std::result::Result<Vec<Scored>, String> {
+    let minp = min_piece.max(1);
+    if width == 0 || paths.is_empty() {
+        return Ok(Vec::new());
+    }
+    let ctx = Beam { g, cp, gp, minp };
+    let (before, after): (Vec<Checkpoint>, Vec<Checkpoint>) =
+        checkpoints(g, cp, gp).into_iter().partition(|c| c.t <= t_cut);
+    if after.is_empty() {
+        return Ok(Vec::new());
+    }
+    let mut pieces = Vec::new();
+    let mut beam = Vec::with_capacity(paths.len());
+    for p in paths {
+        if !place_r(g, p, &cp.start_r, minp, &mut pieces) {
+            continue;
+        }
+        let Some(k) = pieces.iter().position(|q| q.t0 <= t_cut && t_cut < q.t_end()) else { continue };
+        let q = pieces[k];
+        // Terms of the kept prefix: its cuts and the checkpoints up to t_cut.
+        let mut acc = p.cuts[..k].iter().map(|&e| cp.pb.weights.cut * g.edges[e as usize].cost as f64).sum::<f64>();
+        let mut racc = acc;
+        let mut ok = true;
+        for c in &before {
+            let Some(r) = pieces.iter().find(|r| r.t0 <= c.t && c.t < r.t_end()) else {
+                ok = false;
+                break;
+            };
+            match ctx.eval(c, (acc, racc), r.clip, r.first, r.t0, &r.w, 0.0) {
+                Some((a2, r2, _, _, _)) => (acc, racc) = (a2, r2),
+                None => {
+                    ok = false;
+                    break;
+                }
+            }
+        }
+        if !ok {
+            continue;
+        }
+        beam.push(State {
+            start: p.start,
+            cuts: p.cuts[..k].to_vec(),
+            clip: q.clip,
+            a: q.first,
+            ta: q.t0,
+            w: q.w,
+            min_from: (q.first + minp - 1).max(q.first + (t_cut - q.t0)),
+            acc,
+            racc,
+        });
+    }
+    if beam.is_empty() {
+        return Ok(Vec::new());
+    }
+    ctx.run(beam, after, width, rng)
+}
+
+impl Beam<'_> {
+    /// Runs the beam from `beam` over `checkpoints` and scores the complete paths.
+    fn run(
+        &self,
+        mut beam: Vec<State>,
+        checkpoints: Vec<Checkpoint>,
+        width: usize,
+        rng: &mut Rng,
+    ) -> std::result::Result<Vec<Scored>, String> {
+        let (g, cp, gp, minp) = (self.g, self.cp, self.gp, self.minp);
+        let ctx = self;
+        let mut exts = Vec::new();
+        for c in checkpoints {
+            exts.clear();
+            for (si, s) in beam.iter().enumerate() {
+                ctx.extend(si, s, &c, rng, &mut exts);
+            }
+            if exts.is_empty() {
+                return Err(format!("guided seeds: no path reaches frame {}", c.t));
+            }
+            // The beam: `width − quota` extensions by rank, then `quota` by projection rank
+            // (distinct `(clip, frame)`, at most `per_parent` per state).
+            let quota = ((gp.projection_share.clamp(0.0, 1.0) * width as f64) as usize).min(width);
+            let mut seen = HashSet::new();
+            let mut children = vec![0usize; beam.len()];
+            let mut chosen = take_best(&exts, |x| x.rank, width - quota, gp.per_parent, &mut seen, &mut children);
+            let more = take_best(&exts, |x| x.rank2, width - chosen.len(), gp.per_parent, &mut seen, &mut children);
+            chosen.extend(more);
+            let mut next = Vec::with_capacity(width);
+            for i in chosen {
+                let x = &exts[i];
+                let p = &beam[x.parent];
+                let mut cuts = p.cuts.clone();
+                cuts.extend_from_slice(&x.fill[..x.n as usize]);
+                let min_from = if x.n == 0 { p.min_from.max(x.frame) } else { (x.a + minp - 1).max(x.frame) };
+                next.push(State {
+                    start: p.start,
+                    cuts,
+                    clip: x.clip,
+                    a: x.a,
+                    ta: x.ta,
+                    w: x.w,
+                    min_from,
+                    acc: x.acc,
+                    racc: x.racc,
+                });
+            }
+            beam = next;
+        }
+        let mut out: Vec<Scored> = beam
+            .into_iter()
+            .filter_map(|s| {
+                let end_frame = s.a + (cp.target - 1 - s.ta);
+                score(g, cp, &Path { start: s.start, cuts: s.cuts, end_frame }, minp)
+            })
+            .collect();
+        out.sort_by(|a, b| a.score.total_cmp(&b.score));
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::db::{Database, DbParams};
+    use crate::eval::PieceR;
+    use crate::graph::GraphParams;
+    use crate::problem::{random_mg1, Weights};
+    use geom_core::anim::synth::{library, Preset};
+
+    fn small_graph() -> MotionGraph {
+        let clips = library(Preset::Mixed, 10, (90, 140), 30.0, 3);
+        let db = Database::from_motions(clips, &DbParams::default()).unwrap();
+        MotionGraph::build(db, &GraphParams { calibration_pairs: 50_000, ..Default::default() }).unwrap()
+    }
+
+    /// The `(clip, frame)` played at every output time `0 ..= t` of a placed path.
+    fn frames_until(pieces: &[PieceR], t: u32) -> Vec<(u32, u32)> {
+        (0..=t)
+            .map(|u| {
+                let p = pieces.iter().find(|p| p.t0 <= u && u < p.t_end()).unwrap();
+                (p.clip, p.first + (u - p.t0))
+            })
+            .collect()
+    }
+
+    /// The aimed starts are the frames with the smallest uncut projection cost at the first
+    /// body constraint (checked against a brute-force scan of every frame), in increasing cost,
+    /// with at most `max(1, n/16)` per clip.
+    #[test]
+    fn aimed_starts_are_the_best_uncut_projections() {
+        let g = small_graph();
+        let pb = random_mg1(1, 200, 30.0, (1, 1), 4.0, (0.3, 0.8), 1.0, 9, Weights::default()).remove(0);
+        let cp = Compiled::new(&g, pb).unwrap();
+        let b = &cp.pb.body[1];
+        let cost = |f: FrameRef| {
+            let w0 = cp.start_r.compose(&g.torso_r(f.clip, f.frame).inverse());
+            let wt = w0.compose(&g.torso_r(f.clip, f.frame + b.time));
+            cp.w_p * ((wt.x - b.x).powi(2) + (wt.z - b.z).powi(2))
+        };
+        let mut brute = f64::INFINITY;
+        for c in 0..g.db.clips.len() as u32 {
+            for f in 0..g.clip_len(c).saturating_sub(b.time) {
+                brute = brute.min(cost(FrameRef { clip: c, frame: f }));
+            }
+        }
+        let n = 32;
+        let starts = aimed_starts(&g, &cp, 6, n);
+        // Few clips of this small database outlast the constraint time, so fewer than `n`.
+        assert!(!starts.is_empty() && starts.len() <= n);
+        // Same arithmetic as `aimed_starts` (no heading at the intermediate constraint): equal.
+        assert_eq!(cost(starts[0]), brute);
+        for w in starts.windows(2) {
+            assert!(cost(w[0]) <= cost(w[1]));
+        }
+        for c in 0..g.db.clips.len() as u32 {
+            assert!(starts.iter().filter(|s| s.clip == c).count() <= 2);
+        }
+    }
+
+    /// Landing paths have one leaf cut, are valid, end at the hard constraint's time on a
+    /// matching frame, and come in increasing order of the body-constraint terms there.
+    #[test]
+    fn landing_paths_meet_the_hard_constraint_with_one_cut() {
+        let g = small_graph();
+        let mut pb = random_mg1(1, 200, 30.0, (1, 1), 4.0, (0.3, 0.8), 1.0, 9, Weights::default()).remove(0);
+        let label =
+            g.db.labels.iter().find(|l| l.as_str() == "walk").cloned().unwrap_or_else(|| g.db.labels[0].clone());
+        let th = pb.body[1].time;
+        pb.hard.push(crate::problem::HardConstraint::Label { time: th, label });
+        let cp = Compiled::new(&g, pb).unwrap();
+        let (_, h) = cp.hard[0];
+        let paths = landing_paths(&g, &cp, 6, 16);
+        assert!(!paths.is_empty());
+        let b = &cp.pb.body[1];
+        let mut pieces = Vec::new();
+        let mut prev = f64::NEG_INFINITY;
+        for p in &paths {
+            assert_eq!(p.cuts.len(), 1);
+            assert!(place_r(&g, p, &cp.start_r, 6, &mut pieces));
+            let last = pieces[1];
+            assert_eq!(last.t_end(), th + 1);
+            assert!(hard_ok(&g, &h, FrameRef { clip: last.clip, frame: p.end_frame }));
+            let wt = last.w.compose(&g.torso_r(last.clip, p.end_frame));
+            let cost = cp.pb.weights.cut * g.edges[p.cuts[0] as usize].cost as f64
+                + cp.w_p * ((wt.x - b.x).powi(2) + (wt.z - b.z).powi(2));
+            assert!(cost >= prev - 1e-9, "not sorted: {cost} after {prev}");
+            prev = cost;
+        }
+    }
+
+    /// A regrown path plays exactly the frames of one of the kept paths up to the cut time, is
+    /// valid, and its score is the full score of eq. 1.
+    #[test]
+    fn regrow_keeps_the_prefix_up_to_the_cut() {
+        let g = small_graph();
+        let pb = random_mg1(1, 200, 30.0, (2, 2), 4.0, (0.3, 0.8), 1.0, 4, Weights::default()).remove(0);
+        let cp = Compiled::new(&g, pb).unwrap();
+        let gp = GuidedParams { width: 8, ..Default::default() };
+        let mut rng = Rng::new(5);
+        let seeds = guided_seeds(&g, &cp, &gp, 6, &mut rng).unwrap();
+        assert!(!seeds.is_empty());
+        let t_cut = cp.pb.body[1].time;
+        let kept: Vec<&Path> = seeds.iter().map(|s| &s.path).collect();
+        let out = guided_regrow(&g, &cp, &gp, 6, 8, &kept, t_cut, &mut rng).unwrap();
+        assert!(!out.is_empty());
+        let mut pieces = Vec::new();
+        let prefixes: Vec<Vec<(u32, u32)>> = kept
+            .iter()
+            .map(|p| {
+                assert!(place_r(&g, p, &cp.start_r, 6, &mut pieces));
+                frames_until(&pieces, t_cut)
+            })
+            .collect();
+        for s in &out {
+            assert!(place_r(&g, &s.path, &cp.start_r, 6, &mut pieces));
+            let mine = frames_until(&pieces, t_cut);
+            assert!(prefixes.contains(&mine), "regrown path changed its prefix");
+            let full = score(&g, &cp, &s.path, 6).unwrap();
+            assert_eq!(full.score, s.score);
+        }
+    }
 }

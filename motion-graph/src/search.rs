@@ -5,7 +5,7 @@
 
 use crate::eval::{edge_sum, mutated, place_r, score_view, PieceR};
 use crate::graph::{EdgeId, FrameRef, MotionGraph};
-use crate::guided::{guided_seeds, GuidedParams};
+use crate::guided::{guided_regrow, guided_seeds, landing_paths, GuidedParams};
 use crate::path::{hard_ok, score, score_value, Compiled, Hard, Path, Scored};
 use crate::problem::Problem;
 use crate::{Error, Result};
@@ -40,6 +40,9 @@ pub struct SearchParams {
     pub results: usize,
     /// Enable the trim mutation (default on).
     pub trim: bool,
+    /// Repair hard constraints of timing-changing mutations along the diagonal (§12.6; default
+    /// on; off = reject them, as the paper does).
+    pub repair: bool,
     /// All randomness.
     pub rng_seed: u64,
     /// Guided seeds (beam search toward the constraints, ours; `width: 0` disables them).
@@ -60,6 +63,7 @@ impl Default for SearchParams {
             max_seed_tries: 200,
             results: 5,
             trim: true,
+            repair: true,
             rng_seed: 1,
             guided: GuidedParams::default(),
         }
@@ -147,6 +151,11 @@ pub struct Search<'g> {
     stop_at: Option<Tolerance>,
     /// Seeds that failed (for reports).
     pub seed_failures: usize,
+    /// Leaf edges per ordered clip pair keyed by their diagonal `from − to` (sorted), built on
+    /// first use by the repair of hard constraints (§12.6).
+    diagonals: HashMap<(u32, u32), Vec<(i64, EdgeId)>>,
+    /// Candidates whose hard constraints were repaired (§12.6), for reports.
+    pub repairs: usize,
 }
 
 /// Iterations without an improving candidate after which a path counts as a local minimum.
@@ -221,9 +230,12 @@ impl<'g> Search<'g> {
             iterations: 0,
             stop_at: None,
             seed_failures: 0,
+            diagonals: HashMap::new(),
+            repairs: 0,
         };
         let mut last_reason = String::from("no attempt");
-        let guided_reason = s.add_guided().err();
+        let guided_reason = s.add_guided(s.p.guided.initial_width).err();
+        s.add_landings();
         let mut tries = 0;
         while s.population.len() < s.p.seeds.max(1) && tries < s.p.max_seed_tries.max(1) {
             tries += 1;
@@ -246,14 +258,155 @@ impl<'g> Search<'g> {
     }
 
     /// Adds the guided seeds (§13 beam search toward the constraints) to the population.
-    fn add_guided(&mut self) -> std::result::Result<(), String> {
+    /// `width` overrides the beam width when non-zero.
+    fn add_guided(&mut self, width: usize) -> std::result::Result<(), String> {
         let mut rng = self.rng.clone();
-        let r = guided_seeds(self.g, &self.cp, &self.p.guided, self.p.min_piece_frames, &mut rng);
+        let mut gp = self.p.guided;
+        if width > 0 {
+            gp.width = width;
+        }
+        let r = guided_seeds(self.g, &self.cp, &gp, self.p.min_piece_frames, &mut rng);
         self.rng = rng;
         for sc in r? {
             self.push(sc);
         }
         Ok(())
+    }
+
+    /// Repair of hard constraints under mutation (§3.8, §12.6): `np` (a mutation of `old_path`,
+    /// placed as `old`) misses a hard constraint because the mutation shifted the time of the
+    /// pinned piece holding it by `δ` frames. The pinned piece's entry edge `(s, i) → (c, j)` is
+    /// replaced by the cheapest leaf edge of the same clip pair on the diagonal
+    /// `i' − j' = i − j − δ` (so the pinned frame plays at its time again; the rest of the path
+    /// after the pinned piece keeps its timing), leaving the previous piece and entering the
+    /// pinned one validly (the diagonal is computed from the mutated path's placement, so it also
+    /// holds when the mutation changed the previous piece's entry). Repeated for each missed hard constraint; `None` when a missed one is
+    /// in a piece the mutation changed or no edge lies on the diagonal (the candidate is then
+    /// rejected, as the paper does).
+    fn repair(&mut self, old: &[PieceR], old_path: &Path, mut np: Path) -> Option<Path> {
+        let g = self.g;
+        let minp = self.p.min_piece_frames.max(1);
+        let mut pieces = Vec::new();
+        for _ in 0..=self.cp.hard.len() {
+            if !place_r(g, &np, &self.cp.start_r, minp, &mut pieces) {
+                return None;
+            }
+            let at = |t: u32| pieces.iter().find(|p| p.t0 <= t && t < p.t_end());
+            let miss = self.cp.hard.iter().find(|(t, h)| {
+                at(*t).is_none_or(|p| !hard_ok(g, h, FrameRef { clip: p.clip, frame: p.first + (t - p.t0) }))
+            });
+            let Some(&(th, _)) = miss else { return Some(np) };
+            // The pinned piece of the original path and its entry edge.
+            let q = old.iter().position(|p| p.t0 <= th && th < p.t_end())?;
+            if q == 0 {
+                return None;
+            }
+            let e = old_path.cuts[q - 1];
+            let f = old[q].first + (th - old[q].t0);
+            // The same edge and piece in the mutated path.
+            let m = (0..np.cuts.len()).rev().find(|&m| np.cuts[m] == e && pieces[m + 1].last == old[q].last)?;
+            // Leaving the previous piece (entered at frame a at time t_a) at frame i' into frame
+            // j' plays frame j' + t_h − (t_a + i' − a + 1) at t_h: it is f when
+            // i' − j' = t_h − t_a + a − 1 − f (= i − j − δ when the previous piece only moved by δ).
+            let n = &g.edges[e as usize];
+            let (s, c) = (n.from.clip, n.to.clip);
+            let diag = th as i64 - pieces[m].t0 as i64 + pieces[m].first as i64 - 1 - f as i64;
+            if diag == n.from.frame as i64 - n.to.frame as i64 {
+                return None;
+            }
+            let list = self.diagonals.entry((s, c)).or_insert_with(|| {
+                let mut v: Vec<(i64, EdgeId)> = g.out_leaf[s as usize]
+                    .iter()
+                    .filter(|&&x| g.edges[x as usize].to.clip == c)
+                    .map(|&x| {
+                        let d = &g.edges[x as usize];
+                        (d.from.frame as i64 - d.to.frame as i64, x)
+                    })
+                    .collect();
+                v.sort_unstable();
+                v
+            });
+            let lo = list.partition_point(|x| x.0 < diag);
+            let prev_first = pieces[m].first;
+            let best = list[lo..]
+                .iter()
+                .take_while(|x| x.0 == diag)
+                .map(|x| x.1)
+                .filter(|&x| {
+                    let d = &g.edges[x as usize];
+                    d.from.frame + 1 >= prev_first + minp && d.to.frame <= f && d.to.frame + minp <= old[q].last + 1
+                })
+                .min_by(|a, b| g.edges[*a as usize].cost.total_cmp(&g.edges[*b as usize].cost))?;
+            np.cuts[m] = best;
+        }
+        None
+    }
+
+    /// Seeds that land on the first hard constraint with one leaf cut ranked by the body
+    /// constraint at its time ([`landing_paths`]), continued by the beam ([`guided_regrow`]).
+    fn add_landings(&mut self) {
+        let width = self.p.guided.width;
+        let Some(&(th, _)) = self.cp.hard.iter().find(|x| x.0 > 0) else { return };
+        let paths = landing_paths(self.g, &self.cp, self.p.min_piece_frames, width);
+        if paths.is_empty() {
+            return;
+        }
+        let kept: Vec<&Path> = paths.iter().collect();
+        let mut rng = self.rng.clone();
+        let r = guided_regrow(self.g, &self.cp, &self.p.guided, self.p.min_piece_frames, width, &kept, th, &mut rng);
+        self.rng = rng;
+        if let Ok(r) = r {
+            for sc in r {
+                self.push(sc);
+            }
+        }
+    }
+
+    /// Regrows the best paths of the population after a cut time before the worst-met
+    /// constraint of the best path (see [`guided_regrow`]) and adds the results.
+    fn add_regrown(&mut self) {
+        let Some(best) = &self.best else { return };
+        let pb = &self.cp.pb;
+        let last = self.cp.target.saturating_sub(1);
+        // Worst constraint of the best path, by its error over the tolerance-like unit errors.
+        let w = &pb.weights;
+        let mut worst: Option<(f64, u32)> = None;
+        for (i, b) in pb.body.iter().enumerate() {
+            let e = (best.errors.body_pos[i] / w.pos_m).max(best.errors.body_yaw_deg[i] / w.yaw_deg);
+            if b.time > 0 && worst.is_none_or(|x| e > x.0) {
+                worst = Some((e, b.time.min(last)));
+            }
+        }
+        for (i, j) in pb.joints.iter().enumerate() {
+            let e = best.errors.joint[i] / w.joint_m;
+            if worst.is_none_or(|x| e > x.0) {
+                worst = Some((e, j.time.min(last)));
+            }
+        }
+        let Some((_, t_worst)) = worst else { return };
+        let mut cuts: Vec<u32> = std::iter::once(0)
+            .chain(pb.body.iter().map(|b| b.time.min(last)))
+            .chain(pb.joints.iter().map(|j| j.time.min(last)))
+            .chain(self.cp.hard.iter().map(|h| h.0))
+            .filter(|&t| t < t_worst)
+            .collect();
+        cuts.sort_unstable();
+        cuts.dedup();
+        // The constraint just before the worst one half of the time, else any earlier one.
+        let t_cut = if self.rng.f64() < 0.5 { cuts[cuts.len() - 1] } else { cuts[self.rng.below(cuts.len())] };
+        let width = self.p.guided.width;
+        let mut paths: Vec<&Path> = vec![&best.path];
+        paths
+            .extend(self.population.iter().map(|s| &s.path).filter(|p| **p != best.path).take(width.saturating_sub(1)));
+        let mut rng = self.rng.clone();
+        let r =
+            guided_regrow(self.g, &self.cp, &self.p.guided, self.p.min_piece_frames, width, &paths, t_cut, &mut rng);
+        self.rng = rng;
+        if let Ok(r) = r {
+            for sc in r {
+                self.push(sc);
+            }
+        }
     }
 
     fn push(&mut self, sc: Scored) {
@@ -600,7 +753,7 @@ impl<'g> Search<'g> {
             let keep = self.p.keep_best.max(1);
             for c in &cands {
                 scored += 1;
-                let v = if c.start.is_some() {
+                let mut v = if c.start.is_some() {
                     score_value(self.g, &self.cp, &Self::apply(&p.path, c), minp)
                 } else {
                     let mut de = 0.0;
@@ -609,9 +762,21 @@ impl<'g> Search<'g> {
                         .and_then(|v| score_view(self.g, &self.cp, &v, base_edges + de, None))
                         .map(|x| x.0)
                 };
+                // §12.6: a candidate that misses a hard constraint because it moved a pinned
+                // piece in time is repaired along the diagonal (full re-evaluation).
+                let mut repaired = None;
+                if v.is_none() && self.p.repair && !self.cp.hard.is_empty() {
+                    if let Some(rp) = self.repair(&pieces, &p.path, Self::apply(&p.path, c)) {
+                        v = score_value(self.g, &self.cp, &rp, minp);
+                        if v.is_some() {
+                            self.repairs += 1;
+                            repaired = Some(rp);
+                        }
+                    }
+                }
                 if let Some(v) = v {
                     if v < p.score - 1e-12 && (top.len() < keep || v < top[top.len() - 1].0) {
-                        let np = Self::apply(&p.path, c);
+                        let np = repaired.unwrap_or_else(|| Self::apply(&p.path, c));
                         if !top.iter().any(|t| t.1 == np) {
                             top.push((v, np));
                             top.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -651,7 +816,10 @@ impl<'g> Search<'g> {
         }
         self.population = next;
         if self.p.guided.every > 0 && self.iterations.is_multiple_of(self.p.guided.every) {
-            let _ = self.add_guided();
+            let _ = self.add_guided(0);
+        }
+        if self.p.guided.regrow_every > 0 && self.iterations.is_multiple_of(self.p.guided.regrow_every) {
+            self.add_regrown();
         }
         for _ in 0..self.p.new_seeds_per_iter {
             match self.seed() {
@@ -692,7 +860,7 @@ impl<'g> Search<'g> {
             }
             if self.population.is_empty() {
                 // Everything converged: restart from fresh seeds (anytime search).
-                let _ = self.add_guided();
+                let _ = self.add_guided(0);
                 for _ in 0..self.p.seeds.max(1) {
                     if let Ok(s) = self.seed() {
                         self.push(s);
@@ -749,7 +917,7 @@ impl<'g> Search<'g> {
                 self.push(s);
             }
         }
-        let _ = self.add_guided();
+        let _ = self.add_guided(0);
         while self.population.len() < self.p.seeds {
             match self.seed() {
                 Ok(s) => self.push(s),
@@ -773,6 +941,48 @@ mod tests {
     use crate::problem::{random_mg1, HardConstraint, JointConstraint, Weights};
     use geom_core::anim::synth::{library, Preset};
     use geom_core::math::Vec3;
+
+    /// §12.6 repair: candidates that miss a hard `Frame` constraint only because they moved the
+    /// pinned piece in time are repaired; every repaired path is valid, plays the required frame
+    /// at its time, and differs from the unrepaired candidate in entry edges of pinned pieces
+    /// only (same number of cuts). Some repairs must happen on this problem (non-vacuous).
+    #[test]
+    fn repair_restores_hard_constraints_along_the_diagonal() {
+        let clips = library(Preset::Mixed, 10, (90, 140), 30.0, 3);
+        let db = Database::from_motions(clips, &DbParams::default()).unwrap();
+        let g = MotionGraph::build(db, &GraphParams { calibration_pairs: 50_000, ..Default::default() }).unwrap();
+        let mut pb = random_mg1(1, 200, 30.0, (1, 1), 4.0, (0.3, 0.8), 1.0, 5, Weights::default()).remove(0);
+        pb.hard.push(HardConstraint::Frame { time: 120, frame: FrameRef { clip: 3, frame: 60 } });
+        let sp = SearchParams { seeds: 6, population_cap: 8, max_mutations: 400, rng_seed: 3, ..Default::default() };
+        let mut s = Search::new(&g, pb, sp).unwrap();
+        let minp = s.min_piece();
+        let want = FrameRef { clip: 3, frame: 60 };
+        let mut repaired = 0;
+        for _ in 0..3 {
+            let mut pieces = Vec::new();
+            for p in s.population().to_vec() {
+                assert!(place_r(&g, &p.path, &s.cp.start_r, minp, &mut pieces));
+                let mut rng = Rng::new(11);
+                for c in s.mutations(&p.path, &pieces, &mut rng) {
+                    let np = Search::apply(&p.path, &c);
+                    if score_value(&g, &s.cp, &np, minp).is_some() {
+                        continue;
+                    }
+                    let Some(rp) = s.repair(&pieces, &p.path, np.clone()) else { continue };
+                    repaired += 1;
+                    assert!(score_value(&g, &s.cp, &rp, minp).is_some(), "repaired path invalid");
+                    let mut rpieces = Vec::new();
+                    assert!(place_r(&g, &rp, &s.cp.start_r, minp, &mut rpieces));
+                    let q = rpieces.iter().find(|q| q.t0 <= 120 && 120 < q.t_end()).unwrap();
+                    assert_eq!(FrameRef { clip: q.clip, frame: q.first + (120 - q.t0) }, want);
+                    assert_eq!(rp.cuts.len(), np.cuts.len());
+                    assert_eq!((rp.start, rp.end_frame), (np.start, np.end_frame));
+                }
+            }
+            s.step();
+        }
+        assert!(repaired > 0, "no candidate was repaired");
+    }
 
     /// The incremental candidate score (cached placement + view of the mutated path) equals the
     /// full re-evaluation of the mutated path for every candidate of every path of a population

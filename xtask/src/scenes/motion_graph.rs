@@ -269,6 +269,7 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
     let mut residual_max: f64 = 0.0;
     let mut speeds = Vec::new();
     let mut search_cpu_s = Vec::new();
+    let mut repairs = 0usize;
     for (k, pb) in problems.iter().enumerate() {
         let t0 = Instant::now();
         let cpu0 = thread_cpu_s();
@@ -317,6 +318,7 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
         if let (Some(a), Some(b)) = (cpu0, thread_cpu_s()) {
             search_cpu_s.push(b - a);
         }
+        repairs += s.repairs;
         let Some(best) = s.best().cloned() else { continue };
         let b0 = pb
             .body
@@ -417,6 +419,8 @@ pub fn run_search(ctx: &RunCtx) -> Result<Summary> {
     sum.set_count("problems_solved", search_s.len() as u64);
     sum.set("search_s_median", percentile(&search_s, 50.0));
     sum.set("search_s_p90", percentile(&search_s, 90.0));
+    // Mutation candidates whose hard constraints were repaired along the diagonal (§12.6).
+    sum.set_count("mutation_repairs", repairs as u64);
     if search_cpu_s.len() == search_s.len() && !search_cpu_s.is_empty() {
         sum.set("search_cpu_s_median", percentile(&search_cpu_s, 50.0));
     }
