@@ -54,7 +54,7 @@ impl Particles {
     }
 }
 
-use geom_core::spatial::KdTree;
+use crate::surface::SphereTree;
 use rayon::prelude::*;
 
 impl Particles {
@@ -109,14 +109,14 @@ impl Particles {
 /// Ballistic classification (spec §3.8): a particle with no other particle centre within
 /// `factor · r_p` (closed ball) is ballistic. Returns the number of ballistic particles.
 ///
-/// Only the nearest other particle matters, so each particle asks the tree for its two nearest
-/// points (itself and the nearest other one, or two others at distance 0) instead of listing the
-/// whole ball; the distance test is the tree's own `|x_i − x_j|² ≤ (factor r_i)²` expression, so
+/// `tree` is a [`SphereTree`] over `parts.x` (radii unused). One other centre in the ball is
+/// enough, so the search stops at the first (nearest boxes first) instead of listing the whole
+/// ball; the distance test is the k-d tree's own `|x_i − x_j|² ≤ (factor r_i)²` expression, so
 /// the classification equals the radius-query definition exactly.
-pub fn classify_ballistic(parts: &mut Particles, tree: &KdTree, factor: f64, enabled: bool) -> usize {
+pub fn classify_ballistic(parts: &mut Particles, tree: &SphereTree, factor: f64, enabled: bool) -> usize {
     let flags: Vec<bool> = (0..parts.len())
         .into_par_iter()
-        .map_init(Vec::new, |buf, i| {
+        .map(|i| {
             if !enabled {
                 return false;
             }
@@ -126,13 +126,7 @@ pub fn classify_ballistic(parts: &mut Particles, tree: &KdTree, factor: f64, ena
                 // The radius query of an invalid radius is empty: no neighbour.
                 return true;
             }
-            let r2 = reach * reach;
-            tree.knn(&xi, 2, buf);
-            !buf.iter().any(|&(j, _)| {
-                let xj = parts.x[j as usize];
-                let (dx, dy, dz) = (xi.x - xj.x, xi.y - xj.y, xi.z - xj.z);
-                j as usize != i && dx * dx + dy * dy + dz * dz <= r2
-            })
+            !tree.any_other_within2(&xi, reach * reach, i as u32)
         })
         .collect();
     let mut n = 0;
@@ -201,10 +195,11 @@ pub fn apply_obstacles(parts: &mut Particles, sdf: &(dyn Fn(&Pt3) -> f64 + Sync)
 /// `Δx_i = −γ Σ_j vol_j/(vol_i+vol_j) (R_ij − d_ij)(x_j − x_i)/d_ij` with mirrored copies at the
 /// closed box walls, tangential only near the surface (`normal[i]` given, `None` deep inside),
 /// clamped to `0.5 r_i`; a mirrored copy at distance `2 d_w` pushes by `γ (r_i − d_w)`. Velocities are unchanged. Coincident centres use a hashed direction.
+/// `tree` is the [`SphereTree`] of the particle centres with their radii `parts.r`.
 #[allow(clippy::too_many_arguments)] // the wall box and mask, normals and seed are all per-call inputs
 pub fn position_correction(
     parts: &mut Particles,
-    tree: &KdTree,
+    tree: &SphereTree,
     min: &Pt3,
     max: &Pt3,
     closed: &[bool; 6],
@@ -212,7 +207,6 @@ pub fn position_correction(
     gamma: f64,
     seed: u64,
 ) {
-    let rmax = parts.r_max();
     let dx: Vec<Vec3> = (0..parts.len())
         .into_par_iter()
         .map_init(Vec::new, |buf, i| {
@@ -221,9 +215,10 @@ pub fn position_correction(
             }
             let (xi, ri) = (parts.x[i], parts.r[i]);
             let vi = parts.volume(i);
-            buf.clear();
-            // `within` returns the indices sorted ascending (the summation order below).
-            tree.within(&xi, ri + rmax, buf);
+            // Every particle that can overlap `i` (`|x_j − x_i| < r_i + r_j`), indices ascending (the
+            // summation order below): the same pairs, in the same order, as the radius query
+            // `r_i + r_max` used before, without listing the far small particles.
+            tree.touching(&xi, ri, buf);
             let mut d = Vec3::zeros();
             for &j in buf.iter() {
                 let j = j as usize;
@@ -280,11 +275,12 @@ pub fn position_correction(
 mod tests {
     use super::*;
     use geom_core::rng::Rng;
+    use geom_core::spatial::KdTree;
 
     #[test]
     fn ballistic_classification_equals_the_radius_query_definition() {
         // Clusters, isolated particles, exact duplicates and particles exactly at the reach:
-        // the two-nearest test must agree with "no other centre in the closed ball" everywhere.
+        // the first-hit box-tree test must agree with "no other centre in the closed ball" everywhere.
         let mut rng = Rng::new(4);
         let mut p = Particles::default();
         for _ in 0..400 {
@@ -297,8 +293,9 @@ mod tests {
         p.push(Pt3::new(2.0, 2.0, 2.0), Vec3::zeros(), 0.05, 0.0);
         p.push(Pt3::new(2.25, 2.0, 2.0), Vec3::zeros(), 0.05, 0.0); // exactly 5 r away
         let tree = KdTree::build(&p.x);
+        let st = SphereTree::build(&p.x, &vec![0.0; p.len()]);
         for factor in [1.0, 3.0, 5.0, 6.0] {
-            let n = classify_ballistic(&mut p, &tree, factor, true);
+            let n = classify_ballistic(&mut p, &st, factor, true);
             let mut buf = Vec::new();
             let mut expect = 0;
             for i in 0..p.len() {
@@ -310,6 +307,6 @@ mod tests {
             assert_eq!(n, expect);
             assert!(n > 0 && n < p.len(), "factor {factor}: degenerate sample ({n} ballistic)");
         }
-        assert_eq!(classify_ballistic(&mut p, &tree, 6.0, false), 0);
+        assert_eq!(classify_ballistic(&mut p, &st, 6.0, false), 0);
     }
 }

@@ -20,7 +20,7 @@ use crate::particles::{
 use crate::pressure::{apply_pressure, assemble_pressure, PressureSolver, SolveReport, W_MIN};
 use crate::scene::{BoxFace, DtPolicy, Scene, Shape};
 use crate::sizing::{Sizing, SizingContext, SurfaceCurvature, C_H};
-use crate::surface::{level_set_on_nodes, liquid_volume, tet_liquid_volume, Walls};
+use crate::surface::{level_set_on_nodes, level_set_on_nodes_sign_inside, liquid_volume, tet_liquid_volume, Walls};
 use crate::transfer::{blend_weak, extrapolate, node_average, particles_to_tets, pic_fraction, sample};
 
 /// Liquid density used for the energies (kg/m³).
@@ -473,6 +473,12 @@ impl FlipTetSim {
     }
 
     fn level_set(&self) -> Vec<f64> {
+        self.level_set_with(false)
+    }
+
+    /// The node level set; `exact_interior` evaluates every node (the reference the fast path is
+    /// tested against).
+    fn level_set_with(&self, exact_interior: bool) -> Vec<f64> {
         let solid: Option<Vec<bool>> = self.mesh.solid_frac.as_ref().map(|w| {
             (0..self.mesh.nodes.len())
                 .map(|i| self.mesh.node_tets.row(i).iter().all(|&t| w[t as usize] < W_MIN))
@@ -484,7 +490,13 @@ impl FlipTetSim {
             mirror: self.walls(),
             node_in_solid: solid.as_deref(),
         };
-        let mut phi = level_set_on_nodes(&self.mesh, &self.parts, &self.scene.surface, &walls);
+        // Deep liquid nodes only need their sign here: the two redistancing passes below
+        // overwrite them (bitwise equal to `level_set_on_nodes`, test `fast_level_set_equals_exact_in_the_simulation`).
+        let mut phi = if exact_interior {
+            level_set_on_nodes(&self.mesh, &self.parts, &self.scene.surface, &walls)
+        } else {
+            level_set_on_nodes_sign_inside(&self.mesh, &self.parts, &self.scene.surface, &walls)
+        };
         redistance_first_layer(&self.mesh.nodes, &self.edges, &mut phi);
         redistance_interior(&self.mesh.nodes, &self.edges, &mut phi);
         phi
@@ -712,7 +724,7 @@ impl FlipTetSim {
         let g = self.scene.g();
         // 1. Ballistic classification, Δt.
         let c = Instant::now();
-        let tree = KdTree::build(&self.parts.x);
+        let tree = crate::surface::SphereTree::build(&self.parts.x, &vec![0.0; self.parts.len()]);
         st.n_ballistic = classify_ballistic(
             &mut self.parts,
             &tree,
@@ -736,11 +748,10 @@ impl FlipTetSim {
             self.store_particle_phi();
             tm.remesh = c.elapsed().as_secs_f64();
         }
-        let tree = if st.remeshed { KdTree::build(&self.parts.x) } else { tree };
         let m = self.mesh.tets.len();
         // 4–5. P2G and extrapolation.
         let c = Instant::now();
-        let p2g = particles_to_tets(&self.mesh, &self.h_tet, &self.parts, &tree, &self.scene.transfer);
+        let p2g = particles_to_tets(&self.mesh, &self.h_tet, &self.parts, &self.scene.transfer);
         tm.p2g = c.elapsed().as_secs_f64();
         let c = Instant::now();
         let layers = self.scene.transfer.extrapolation_layers.unwrap_or(self.scene.flip.cfl.ceil() as u32 + 2);
@@ -931,7 +942,7 @@ impl FlipTetSim {
                     (n > 0.0).then(|| gr / n)
                 })
                 .collect();
-            let tree = KdTree::build(&self.parts.x);
+            let tree = crate::surface::SphereTree::build(&self.parts.x, &self.parts.r);
             let closed = self.walls();
             let seed = self.scene.seed ^ self.step.wrapping_mul(0x9e37_79b9_7f4a_7c15);
             position_correction(
@@ -1106,6 +1117,46 @@ mod tests {
                     assert!(-p <= 1.25 * -e + 0.25, "node {i}: {p} far deeper than {e}");
                 }
             }
+        }
+    }
+
+    /// The simulator's level set with cheap stand-ins at deep liquid nodes equals the fully
+    /// evaluated one bitwise after the redistancing passes, at every step of a collapsing column
+    /// (remeshing, split/merge, splashing) and of a droplet plus pool with an isolated blob.
+    #[test]
+    fn fast_level_set_equals_exact_in_the_simulation() {
+        let scenes = [
+            r#"(domain: (min: (0.0, 0.0, 0.0), max: (0.5, 0.25, 0.125)),
+                resolution: (coarsest: 4, finest: 16), duration: 0.1, fps: 60.0,
+                liquid: [Box(min: (0.0, 0.0, 0.0), max: (0.125, 0.1875, 0.125))],
+                sizing: (depth_floor: Some(0.25), surface_band: Some(3.0)),
+                flip: (remesh_interval: 3))"#,
+            r#"(domain: (min: (0.0, 0.0, 0.0), max: (0.5, 0.5, 0.5)),
+                resolution: (coarsest: 4, finest: 16), duration: 0.1, fps: 60.0,
+                liquid: [Box(min: (0.0, 0.0, 0.0), max: (0.5, 0.125, 0.5)),
+                         Sphere(center: (0.25, 0.34, 0.25), radius: 0.08)],
+                sizing: (depth_floor: Some(0.25), surface_band: Some(3.0)),
+                flip: (remesh_interval: 2))"#,
+        ];
+        for text in scenes {
+            let scene: Scene = ron::from_str(text).unwrap();
+            let mut sim = FlipTetSim::new(&scene).unwrap();
+            let mut stand_ins = 0;
+            for _ in 0..8 {
+                let exact = sim.level_set_with(true);
+                let fast = sim.level_set_with(false);
+                assert_eq!(exact.len(), fast.len());
+                for (i, (a, b)) in exact.iter().zip(&fast).enumerate() {
+                    assert_eq!(a.to_bits(), b.to_bits(), "node {i}: {a} vs {b}");
+                }
+                // The fast path did skip work: some nodes were deep (not first-layer) liquid.
+                let nbrs = &sim.mesh.node_nbrs;
+                stand_ins += (0..exact.len())
+                    .filter(|&i| exact[i] < 0.0 && nbrs.row(i).iter().all(|&j| exact[j as usize] < 0.0))
+                    .count();
+                sim.step().unwrap();
+            }
+            assert!(stand_ins > 100, "{stand_ins}");
         }
     }
 

@@ -19,7 +19,8 @@ use serde::{Deserialize, Serialize};
 pub use extract::{marching_tets, smooth_surface, vertex_curvature, SNAP_REL, TAUBIN_LAMBDA, TAUBIN_MU};
 pub use hull::{facet_distance, hull_distance, pair_distance};
 pub use levelset::{
-    extend_into_solids, level_set_on_nodes, node_edges, node_sizes, redistance_interior, LevelSetSampler, Walls,
+    extend_into_solids, level_set_on_nodes, level_set_on_nodes_sign_inside, node_edges, node_sizes,
+    redistance_interior, LevelSetSampler, Walls,
 };
 pub use spheretree::SphereTree;
 pub(crate) use volume::tet_volume;

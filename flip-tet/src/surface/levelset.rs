@@ -195,6 +195,35 @@ impl LevelSetSampler {
         }
     }
 
+    /// [`Self::value_on_node`] for a caller that needs only the sign of nodes strictly inside the
+    /// sphere union: returns `(v, true)` with `v` bitwise equal to [`Self::value_on_node`], or
+    /// `(v, false)` with some `v < 0` when a source sphere contains `q` (`|q − x_s| − r_s < 0`,
+    /// so the exact value is negative too: the hulls and the clamp only lower it or keep it
+    /// below zero). The sphere search stops at the first such source instead of finding the
+    /// minimum, and no hulls are evaluated: deep liquid nodes cost one leaf scan.
+    pub fn value_on_node_or_inside(&self, q: &Pt3, h: f64) -> (f64, bool) {
+        let band = self.band(h);
+        if self.src.is_empty() || self.params.method != SurfaceMethod::Hulls {
+            return (self.value_on_node(q, h), true);
+        }
+        let eps = PRUNE_EPS * band;
+        let search = 2.0 * self.params.hull_l * self.r_max + band;
+        let phi_s = self.tree.min_value_until(q, search, band, eps, 0.0);
+        if phi_s < 0.0 {
+            return (phi_s.max(-band), false);
+        }
+        // `φ_s ≥ 0` (or NaN): the search did not stop early, so `φ_s` is `min_value`'s result and
+        // the rest is `value_on_node` verbatim.
+        if phi_s.is_nan() || phi_s.abs() > band {
+            return (phi_s.clamp(-band, band), true);
+        }
+        if phi_s > -self.near_r_max - eps && phi_s <= h + self.hull_reach() {
+            (phi_s.min(self.hulls_pruned(q, phi_s, eps, Some(h))), true)
+        } else {
+            (phi_s, true)
+        }
+    }
+
     /// The reference evaluation of [`Self::value`]: the sphere union over every source in the
     /// search ball (k-d tree radius query) and every pair and triplet of the `K` nearest
     /// near-surface sources, without pruning. Kept for tests and for the Zhu–Bridson method.
@@ -391,6 +420,93 @@ pub fn level_set_on_nodes(mesh: &TetMesh, parts: &Particles, params: &SurfacePar
     if let Some(solid) = walls.node_in_solid {
         extend_into_solids(edges, solid, &mut phi);
     }
+    phi
+}
+
+/// [`level_set_on_nodes`] for a caller that redistances the liquid interior itself (the
+/// simulator: `sim::redistance_first_layer` then `sim::redistance_interior`), which overwrites
+/// every liquid node that has no air neighbour (`φ ≥ 0`) and is connected along liquid edges to
+/// one that has. Such nodes only need their sign, so nodes inside a source sphere get a cheap
+/// negative stand-in ([`LevelSetSampler::value_on_node_or_inside`]) unless they are needed:
+///
+/// 1. liquid nodes with an air neighbour (the first layer: the seeds of the caller's
+///    redistancing) get their exact value;
+/// 2. liquid components with no first-layer node (the caller cannot reach them) get exact values;
+/// 3. if a first-layer node lies at or below its band (`φ ≤ −band`, which the 1-Lipschitz level
+///    set rules out in practice), the band redistancing below would read stand-ins: every node is
+///    then computed exactly.
+///
+/// Every other node (air, first layer, unreachable liquid) carries exactly the value of
+/// [`level_set_on_nodes`], and the signs of all nodes are the same, so after the caller's two
+/// redistancing passes both give bitwise equal fields (tested in `sim`). With obstacles
+/// (`walls.node_in_solid`) the solid extension reads interior values: this falls back to
+/// [`level_set_on_nodes`].
+pub fn level_set_on_nodes_sign_inside(
+    mesh: &TetMesh,
+    parts: &Particles,
+    params: &SurfaceParams,
+    walls: &Walls,
+) -> Vec<f64> {
+    if walls.node_in_solid.is_some() || params.method != SurfaceMethod::Hulls {
+        return level_set_on_nodes(mesh, parts, params, walls);
+    }
+    let sampler = LevelSetSampler::new(parts, params, walls);
+    let n = mesh.nodes.len();
+    let h_own;
+    let h: &[f64] = if mesh.node_h.len() == n {
+        &mesh.node_h
+    } else {
+        h_own = node_sizes(mesh);
+        &h_own
+    };
+    let edges_own;
+    let edges: &Ragged<u32> = if mesh.node_nbrs.len() == n {
+        &mesh.node_nbrs
+    } else {
+        edges_own = node_edges(mesh);
+        &edges_own
+    };
+    let first: Vec<(f64, bool)> =
+        mesh.nodes.par_iter().zip(h.par_iter()).map(|(q, &hq)| sampler.value_on_node_or_inside(q, hq)).collect();
+    let mut phi: Vec<f64> = first.iter().map(|v| v.0).collect();
+    let mut exact: Vec<bool> = first.iter().map(|v| v.1).collect();
+    let fill = |phi: &mut [f64], exact: &mut [bool], idx: &[usize]| {
+        let vals: Vec<f64> = idx.par_iter().map(|&i| sampler.value_on_node(&mesh.nodes[i], h[i])).collect();
+        for (&i, v) in idx.iter().zip(vals) {
+            phi[i] = v;
+            exact[i] = true;
+        }
+    };
+    // 1. First layer. Stand-ins are negative, so every air node (`φ ≥ 0`) already has its exact
+    // value and a stand-in's exact value is negative too: signs are final after this.
+    let need: Vec<usize> =
+        (0..n).filter(|&i| !exact[i] && edges.row(i).iter().any(|&j| phi[j as usize] >= 0.0)).collect();
+    fill(&mut phi, &mut exact, &need);
+    // 2. Liquid reachable from the first layer, with the caller's traversal rule (`φ < 0` or NaN).
+    let first_layer = |phi: &[f64], i: usize| phi[i] < 0.0 && edges.row(i).iter().any(|&j| phi[j as usize] >= 0.0);
+    let mut seen = vec![false; n];
+    let mut stack: Vec<usize> = (0..n).filter(|&i| first_layer(&phi, i)).collect();
+    for &i in &stack {
+        seen[i] = true;
+    }
+    while let Some(i) = stack.pop() {
+        for &j in edges.row(i) {
+            let j = j as usize;
+            if !seen[j] && (phi[j] < 0.0 || phi[j].is_nan()) {
+                seen[j] = true;
+                stack.push(j);
+            }
+        }
+    }
+    let need: Vec<usize> = (0..n).filter(|&i| !exact[i] && !seen[i]).collect();
+    fill(&mut phi, &mut exact, &need);
+    let bands: Vec<f64> = h.iter().map(|&hq| sampler.band(hq)).collect();
+    // 3. Guard: a first-layer node at or below its band would be rewritten from stand-ins.
+    if (0..n).any(|i| phi[i] <= -bands[i] && first_layer(&phi, i)) {
+        let need: Vec<usize> = (0..n).filter(|&i| !exact[i]).collect();
+        fill(&mut phi, &mut exact, &need);
+    }
+    redistance_interior(&mesh.nodes, edges, &bands, &mut phi);
     phi
 }
 

@@ -4,8 +4,9 @@
 //! The level set (spec §3.11.3) needs, at every node, the union-of-spheres value over all sources
 //! within `search = 2 l r_max + band`, clamped to `±band`. A plain radius query visits every source
 //! in that ball (thousands of particles per node at the simulation's `h = 4 r`). Here every tree
-//! node stores its box and the largest radius below it, so a subtree whose lower bound
-//! `dist(q, box) − r_max(subtree)` already exceeds the current minimum (or the band) is skipped,
+//! node stores its box, the largest radius below it and the box of its balls, so a subtree whose
+//! lower bound `max(dist(q, box) − r_max(subtree), dist(q, ball box))` already exceeds the current
+//! minimum (or the band) is skipped,
 //! and the search stops once the minimum is below `−band` (the value is then clamped anyway).
 //! The per-source arithmetic and the ball test are the same expressions as the exhaustive scan,
 //! and skipped sources provably cannot lower the minimum, so the result is bitwise equal to the
@@ -25,6 +26,12 @@ struct Node {
     max: [f64; 3],
     /// Largest source radius in the subtree (m).
     rmax: f64,
+    /// Bounding box of the balls `x_s ± r_s` of the subtree (m): for `q` outside it, every
+    /// source value `|q − x_s| − r_s` is at least the distance from `q` to this box. Much tighter than
+    /// `dist(q, centre box) − rmax` for subtrees that mix small surface particles with the large
+    /// interior radii of deep ones.
+    bmin: [f64; 3],
+    bmax: [f64; 3],
     /// Source range `[lo, hi)` in tree order.
     lo: u32,
     hi: u32,
@@ -42,6 +49,8 @@ pub struct SphereTree {
     pts: Vec<Pt3>,
     /// Radii in tree order.
     r: Vec<f64>,
+    /// Input index of each source, in tree order.
+    idx: Vec<u32>,
 }
 
 /// Squared distance from `q` to the box `[min, max]` (0 inside). For a point `p` of the box every
@@ -68,12 +77,13 @@ impl SphereTree {
     /// box axis; ties broken by index, so the build is deterministic).
     pub fn build(centres: &[Pt3], radii: &[f64]) -> Self {
         let mut order: Vec<u32> = (0..centres.len() as u32).collect();
-        let mut t = Self { nodes: Vec::new(), pts: Vec::new(), r: Vec::new() };
+        let mut t = Self { nodes: Vec::new(), pts: Vec::new(), r: Vec::new(), idx: Vec::new() };
         if !order.is_empty() {
             t.build_range(centres, radii, &mut order, 0);
         }
         t.pts = order.iter().map(|&i| centres[i as usize]).collect();
         t.r = order.iter().map(|&i| radii[i as usize]).collect();
+        t.idx = order;
         t
     }
 
@@ -81,17 +91,32 @@ impl SphereTree {
         let mut min = [f64::INFINITY; 3];
         let mut max = [f64::NEG_INFINITY; 3];
         let mut rmax = f64::NEG_INFINITY;
+        let mut bmin = [f64::INFINITY; 3];
+        let mut bmax = [f64::NEG_INFINITY; 3];
         for &i in order.iter() {
             let p = c[i as usize];
+            let ri = r[i as usize];
             for k in 0..3 {
                 min[k] = min[k].min(p[k]);
                 max[k] = max[k].max(p[k]);
+                bmin[k] = bmin[k].min(p[k] - ri);
+                bmax[k] = bmax[k].max(p[k] + ri);
             }
-            rmax = rmax.max(r[i as usize]);
+            rmax = rmax.max(ri);
         }
         let id = self.nodes.len() as u32;
         let n = order.len();
-        self.nodes.push(Node { min, max, rmax, lo: lo as u32, hi: (lo + n) as u32, left: u32::MAX, right: u32::MAX });
+        self.nodes.push(Node {
+            min,
+            max,
+            rmax,
+            bmin,
+            bmax,
+            lo: lo as u32,
+            hi: (lo + n) as u32,
+            left: u32::MAX,
+            right: u32::MAX,
+        });
         if n <= LEAF {
             return id;
         }
@@ -146,6 +171,120 @@ impl SphereTree {
         false
     }
 
+    /// Whether some centre other than input index `except` has `dx² + dy² + dz² ≤ r2`
+    /// (`d = q − x_s`): the ballistic test "a neighbour within the reach" with the k-d tree's
+    /// expression. Nearer children are searched first and the search stops at the first hit.
+    pub fn any_other_within2(&self, q: &Pt3, r2: f64, except: u32) -> bool {
+        if self.nodes.is_empty() || r2.is_nan() {
+            return false;
+        }
+        let qa = [q.x, q.y, q.z];
+        let mut stack = [0u32; STACK];
+        let mut sp = 1usize;
+        while sp > 0 {
+            sp -= 1;
+            let n = &self.nodes[stack[sp] as usize];
+            if box_dist2(&qa, &n.min, &n.max) > r2 {
+                continue;
+            }
+            if n.left == u32::MAX || sp + 2 > STACK {
+                for k in n.lo as usize..n.hi as usize {
+                    let p = &self.pts[k];
+                    let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
+                    if self.idx[k] != except && dx * dx + dy * dy + dz * dz <= r2 {
+                        return true;
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (&self.nodes[n.left as usize], &self.nodes[n.right as usize]);
+            let (near, far) = if box_dist2(&qa, &a.min, &a.max) <= box_dist2(&qa, &b.min, &b.max) {
+                (n.left, n.right)
+            } else {
+                (n.right, n.left)
+            };
+            stack[sp] = far;
+            stack[sp + 1] = near;
+            sp += 2;
+        }
+        false
+    }
+
+    /// Input indices (ascending) of the centres with `dx² + dy² + dz² ≤ rad²` (`d = q − x_s`): the
+    /// same predicate and order as geom-core's `KdTree::within`, so the two lists are equal. The
+    /// boxes of 8-source leaves prune whole regions, which is cheaper than the k-d tree's
+    /// one-point-per-node descent for the many small gathers of P2G.
+    pub fn within(&self, q: &Pt3, rad: f64, out: &mut Vec<u32>) {
+        out.clear();
+        if self.nodes.is_empty() || rad.is_nan() || rad < 0.0 {
+            return;
+        }
+        let r2 = rad * rad;
+        let qa = [q.x, q.y, q.z];
+        let mut stack = [0u32; STACK];
+        let mut sp = 1usize;
+        while sp > 0 {
+            sp -= 1;
+            let n = &self.nodes[stack[sp] as usize];
+            // Monotone rounding: no point of the box has a smaller rounded `d²` than the box.
+            if box_dist2(&qa, &n.min, &n.max) > r2 {
+                continue;
+            }
+            if n.left == u32::MAX || sp + 2 > STACK {
+                for k in n.lo as usize..n.hi as usize {
+                    let p = &self.pts[k];
+                    let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
+                    if dx * dx + dy * dy + dz * dz <= r2 {
+                        out.push(self.idx[k]);
+                    }
+                }
+                continue;
+            }
+            stack[sp] = n.right;
+            stack[sp + 1] = n.left;
+            sp += 2;
+        }
+        out.sort_unstable();
+    }
+
+    /// Input indices (ascending) of the spheres that can overlap the ball `(q, rad)`: every source
+    /// with `|q − x_s| < rad + r_s` is listed (with a relative slack of `1e−12` against rounding, so
+    /// a few just-touching ones may be listed too; the caller keeps its exact test). Subtrees are
+    /// pruned with their own largest radius, so a small query among a few large spheres does not
+    /// list everything within `rad + max r` as a plain radius query must.
+    pub fn touching(&self, q: &Pt3, rad: f64, out: &mut Vec<u32>) {
+        out.clear();
+        if self.nodes.is_empty() || rad.is_nan() {
+            return;
+        }
+        const SLACK: f64 = 1.0 + 1e-12;
+        let qa = [q.x, q.y, q.z];
+        let mut stack = [0u32; STACK];
+        let mut sp = 1usize;
+        while sp > 0 {
+            sp -= 1;
+            let n = &self.nodes[stack[sp] as usize];
+            // Monotone rounding: no point of the box is closer than the box itself.
+            if box_dist2(&qa, &n.min, &n.max).sqrt() > (rad + n.rmax) * SLACK {
+                continue;
+            }
+            if n.left == u32::MAX || sp + 2 > STACK {
+                for k in n.lo as usize..n.hi as usize {
+                    let p = &self.pts[k];
+                    let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
+                    if (dx * dx + dy * dy + dz * dz).sqrt() <= (rad + self.r[k]) * SLACK {
+                        out.push(self.idx[k]);
+                    }
+                }
+                continue;
+            }
+            stack[sp] = n.right;
+            stack[sp + 1] = n.left;
+            sp += 2;
+        }
+        out.sort_unstable();
+    }
+
     /// Minimum of `best` and `|q − x_s| − r_s` over the sources of `n`'s range inside the closed
     /// ball `|q − x_s|² ≤ s2` (the squared distance is the k-d tree's `dx² + dy² + dz²`).
     fn scan(&self, q: &Pt3, s2: f64, n: &Node, mut best: f64) -> f64 {
@@ -170,6 +309,15 @@ impl SphereTree {
     /// unclamped result equals the exhaustive minimum whenever that lies in `[−band, band]`.
     /// `eps` (m, ≥ 0) is the safety margin subtracted from every lower bound against rounding.
     pub fn min_value(&self, q: &Pt3, search: f64, band: f64, eps: f64) -> f64 {
+        self.min_value_until(q, search, band, eps, -band)
+    }
+
+    /// [`Self::min_value`] that stops as soon as the running minimum is `< stop` (`stop ≥ −band`)
+    /// and returns it: the exact minimum is then `< stop` too (it is at most any term found).
+    /// When the result is `≥ stop` the search never stopped early and the result equals
+    /// [`Self::min_value`] bitwise (same traversal, same pruning, same arithmetic). With
+    /// `stop = 0` this decides "inside the sphere union" for a node that only needs its sign.
+    pub fn min_value_until(&self, q: &Pt3, search: f64, band: f64, eps: f64, stop: f64) -> f64 {
         let mut best = f64::INFINITY;
         if self.nodes.is_empty() || search.is_nan() || search < 0.0 {
             return best;
@@ -185,13 +333,16 @@ impl SphereTree {
             if d2b > s2 {
                 continue;
             }
-            let lb = d2b.sqrt() - n.rmax - eps;
+            // Outside the ball box `q` is outside every ball, so each value is at least the
+            // distance to that box; inside it only the centre-box bound holds.
+            let db = box_dist2(&qa, &n.bmin, &n.bmax).sqrt();
+            let lb = if db > 0.0 { (d2b.sqrt() - n.rmax).max(db) } else { d2b.sqrt() - n.rmax } - eps;
             if lb > band || lb >= best {
                 continue;
             }
             if n.left == u32::MAX {
                 best = self.scan(q, s2, n, best);
-                if best < -band {
+                if best < stop {
                     return best;
                 }
                 continue;
@@ -238,6 +389,37 @@ mod tests {
             hits += usize::from(want);
         }
         assert!(hits > 200 && hits < 3800, "{hits}");
+        // `within` lists exactly what the k-d tree lists, in the same order.
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for i in 0..500 {
+            let q = Pt3::new(rng.range(-0.2, 1.2), rng.range(-0.2, 0.4), rng.range(-0.2, 1.2));
+            let rad = if i % 10 == 0 { kd.nearest(&q).map_or(0.05, |(_, d)| d) } else { rng.range(0.0, 0.08) };
+            tree.within(&q, rad, &mut a);
+            kd.within(&q, rad, &mut b);
+            assert_eq!(a, b, "q = {q:?}, rad = {rad}");
+        }
+        // `touching` lists exactly the overlapping spheres (plus only near-ties), ascending.
+        let radii: Vec<f64> = (0..pts.len()).map(|i| if i % 7 == 0 { 0.08 } else { 0.01 }).collect();
+        let st = SphereTree::build(&pts, &radii);
+        let mut out = Vec::new();
+        let mut listed = 0;
+        for _ in 0..500 {
+            let q = Pt3::new(rng.range(-0.1, 1.1), rng.range(-0.1, 0.3), rng.range(-0.1, 1.1));
+            let rad = rng.range(0.0, 0.02);
+            st.touching(&q, rad, &mut out);
+            assert!(out.windows(2).all(|w| w[0] < w[1]));
+            for (i, p) in pts.iter().enumerate() {
+                let d = (p - q).norm();
+                let listed_i = out.binary_search(&(i as u32)).is_ok();
+                if d < rad + radii[i] {
+                    assert!(listed_i, "missing {i}");
+                } else if listed_i {
+                    assert!(d <= (rad + radii[i]) * (1.0 + 1e-11), "extra {i}");
+                }
+            }
+            listed += out.len();
+        }
+        assert!(listed > 500, "{listed}");
         assert!(!SphereTree::build(&[], &[]).any_closer(&Pt3::origin(), 1.0));
     }
 }

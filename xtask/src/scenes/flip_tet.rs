@@ -125,6 +125,16 @@ fn common(s: &mut Summary, stats: &[StepStats], wall: f64) {
     for (k, v) in ["remesh", "transfer", "solve", "advect", "surface"].iter().zip(st) {
         s.set(&format!("time_{k}_s"), v);
     }
+    // The phases inside those stages (profiling aid: which part of a stage dominates).
+    let phase = |f: fn(&flip_tet::sim::PhaseTimings) -> f64| stats.iter().map(|x| f(&x.timings)).sum::<f64>();
+    s.set("phase_p2g_s", phase(|t| t.p2g));
+    s.set("phase_extrapolate_s", phase(|t| t.extrapolate));
+    s.set("phase_g2p_s", phase(|t| t.g2p));
+    s.set("phase_assemble_s", phase(|t| t.assemble));
+    s.set("phase_linear_solve_s", phase(|t| t.solve));
+    s.set("phase_advect_s", phase(|t| t.advect));
+    s.set("phase_correction_s", phase(|t| t.correction));
+    s.set("phase_ballistic_s", phase(|t| t.ballistic));
     s.set_str("profile", if cfg!(debug_assertions) { "debug" } else { "release" });
 }
 
