@@ -142,72 +142,41 @@ impl SphereTree {
     /// boxes prune empty regions after a few levels, unlike a split-plane k-d tree, which makes
     /// this the cheap "is this tet far from every particle" test of a gather over all tets.
     pub fn any_closer(&self, q: &Pt3, rad: f64) -> bool {
-        if self.nodes.is_empty() || rad.is_nan() {
+        if rad.is_nan() {
             return false;
         }
         let qa = [q.x, q.y, q.z];
-        let mut stack = [0u32; STACK];
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let n = &self.nodes[stack[sp] as usize];
-            // Monotone rounding: no point of the box is closer than the box itself.
-            if box_dist2(&qa, &n.min, &n.max).sqrt() >= rad {
-                continue;
-            }
-            if n.left == u32::MAX || sp + 2 > STACK {
-                for p in &self.pts[n.lo as usize..n.hi as usize] {
-                    let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
-                    if (dx * dx + dy * dy + dz * dz).sqrt() < rad {
-                        return true;
-                    }
-                }
-                continue;
-            }
-            stack[sp] = n.right;
-            stack[sp + 1] = n.left;
-            sp += 2;
-        }
-        false
+        // Monotone rounding: no point of the box is closer than the box itself.
+        self.traverse(
+            &qa,
+            false,
+            |n| box_dist2(&qa, &n.min, &n.max).sqrt() >= rad,
+            |k| {
+                let p = &self.pts[k];
+                let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
+                (dx * dx + dy * dy + dz * dz).sqrt() < rad
+            },
+        )
     }
 
     /// Whether some centre other than input index `except` has `dx² + dy² + dz² ≤ r2`
     /// (`d = q − x_s`): the ballistic test "a neighbour within the reach" with the k-d tree's
     /// expression. Nearer children are searched first and the search stops at the first hit.
     pub fn any_other_within2(&self, q: &Pt3, r2: f64, except: u32) -> bool {
-        if self.nodes.is_empty() || r2.is_nan() {
+        if r2.is_nan() {
             return false;
         }
         let qa = [q.x, q.y, q.z];
-        let mut stack = [0u32; STACK];
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let n = &self.nodes[stack[sp] as usize];
-            if box_dist2(&qa, &n.min, &n.max) > r2 {
-                continue;
-            }
-            if n.left == u32::MAX || sp + 2 > STACK {
-                for k in n.lo as usize..n.hi as usize {
-                    let p = &self.pts[k];
-                    let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
-                    if self.idx[k] != except && dx * dx + dy * dy + dz * dz <= r2 {
-                        return true;
-                    }
-                }
-                continue;
-            }
-            let (a, b) = (&self.nodes[n.left as usize], &self.nodes[n.right as usize]);
-            let (near, far) = if box_dist2(&qa, &a.min, &a.max) <= box_dist2(&qa, &b.min, &b.max) {
-                (n.left, n.right)
-            } else {
-                (n.right, n.left)
-            };
-            stack[sp] = far;
-            stack[sp + 1] = near;
-            sp += 2;
-        }
-        false
+        self.traverse(
+            &qa,
+            true,
+            |n| box_dist2(&qa, &n.min, &n.max) > r2,
+            |k| {
+                let p = &self.pts[k];
+                let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
+                self.idx[k] != except && dx * dx + dy * dy + dz * dz <= r2
+            },
+        )
     }
 
     /// Input indices (ascending) of the centres with `dx² + dy² + dz² ≤ rad²` (`d = q − x_s`): the
@@ -216,34 +185,25 @@ impl SphereTree {
     /// one-point-per-node descent for the many small gathers of P2G.
     pub fn within(&self, q: &Pt3, rad: f64, out: &mut Vec<u32>) {
         out.clear();
-        if self.nodes.is_empty() || rad.is_nan() || rad < 0.0 {
+        if rad.is_nan() || rad < 0.0 {
             return;
         }
         let r2 = rad * rad;
         let qa = [q.x, q.y, q.z];
-        let mut stack = [0u32; STACK];
-        let mut sp = 1usize;
-        while sp > 0 {
-            sp -= 1;
-            let n = &self.nodes[stack[sp] as usize];
-            // Monotone rounding: no point of the box has a smaller rounded `d²` than the box.
-            if box_dist2(&qa, &n.min, &n.max) > r2 {
-                continue;
-            }
-            if n.left == u32::MAX || sp + 2 > STACK {
-                for k in n.lo as usize..n.hi as usize {
-                    let p = &self.pts[k];
-                    let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
-                    if dx * dx + dy * dy + dz * dz <= r2 {
-                        out.push(self.idx[k]);
-                    }
+        // Monotone rounding: no point of the box has a smaller rounded `d²` than the box.
+        self.traverse(
+            &qa,
+            false,
+            |n| box_dist2(&qa, &n.min, &n.max) > r2,
+            |k| {
+                let p = &self.pts[k];
+                let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
+                if dx * dx + dy * dy + dz * dz <= r2 {
+                    out.push(self.idx[k]);
                 }
-                continue;
-            }
-            stack[sp] = n.right;
-            stack[sp + 1] = n.left;
-            sp += 2;
-        }
+                false
+            },
+        );
         out.sort_unstable();
     }
 
@@ -254,35 +214,71 @@ impl SphereTree {
     /// list everything within `rad + max r` as a plain radius query must.
     pub fn touching(&self, q: &Pt3, rad: f64, out: &mut Vec<u32>) {
         out.clear();
-        if self.nodes.is_empty() || rad.is_nan() {
+        if rad.is_nan() {
             return;
         }
         const SLACK: f64 = 1.0 + 1e-12;
         let qa = [q.x, q.y, q.z];
+        // Monotone rounding: no point of the box is closer than the box itself.
+        self.traverse(
+            &qa,
+            false,
+            |n| box_dist2(&qa, &n.min, &n.max).sqrt() > (rad + n.rmax) * SLACK,
+            |k| {
+                let p = &self.pts[k];
+                let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
+                if (dx * dx + dy * dy + dz * dz).sqrt() <= (rad + self.r[k]) * SLACK {
+                    out.push(self.idx[k]);
+                }
+                false
+            },
+        );
+        out.sort_unstable();
+    }
+
+    /// Depth-first traversal shared by the queries above: subtrees with `skip(node)` are pruned,
+    /// `visit(k)` is called for every source slot `k` (tree order) of the reached leaves (a node
+    /// is scanned as a leaf when the fixed stack is full), and the traversal stops and returns
+    /// true as soon as `visit` does. With `near_first` the child whose box is nearer to `qa` is
+    /// entered first (the left one on ties), else always the left one.
+    #[inline]
+    fn traverse(
+        &self,
+        qa: &[f64; 3],
+        near_first: bool,
+        skip: impl Fn(&Node) -> bool,
+        mut visit: impl FnMut(usize) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
         let mut stack = [0u32; STACK];
         let mut sp = 1usize;
         while sp > 0 {
             sp -= 1;
             let n = &self.nodes[stack[sp] as usize];
-            // Monotone rounding: no point of the box is closer than the box itself.
-            if box_dist2(&qa, &n.min, &n.max).sqrt() > (rad + n.rmax) * SLACK {
+            if skip(n) {
                 continue;
             }
             if n.left == u32::MAX || sp + 2 > STACK {
                 for k in n.lo as usize..n.hi as usize {
-                    let p = &self.pts[k];
-                    let (dx, dy, dz) = (qa[0] - p.x, qa[1] - p.y, qa[2] - p.z);
-                    if (dx * dx + dy * dy + dz * dz).sqrt() <= (rad + self.r[k]) * SLACK {
-                        out.push(self.idx[k]);
+                    if visit(k) {
+                        return true;
                     }
                 }
                 continue;
             }
-            stack[sp] = n.right;
-            stack[sp + 1] = n.left;
+            let (a, b) = (&self.nodes[n.left as usize], &self.nodes[n.right as usize]);
+            let (first, second) = if near_first && box_dist2(qa, &b.min, &b.max) < box_dist2(qa, &a.min, &a.max) {
+                (n.right, n.left)
+            } else {
+                (n.left, n.right)
+            };
+            stack[sp] = second;
+            stack[sp + 1] = first;
             sp += 2;
         }
-        out.sort_unstable();
+        false
     }
 
     /// Minimum of `best` and `|q − x_s| − r_s` over the sources of `n`'s range inside the closed
