@@ -47,7 +47,11 @@ fn main() -> motion_graph::Result<()> {
                 )
             })
             .collect();
-        println!("problem {k}: {} | end yaw {:.0}°", seg.join(", "), pb.body.last().unwrap().yaw.unwrap().to_degrees());
+        println!(
+            "problem {k}: {} | end yaw {:.0}°",
+            seg.join(", "),
+            pb.body.last().and_then(|c| c.yaw).map_or(f64::NAN, f64::to_degrees)
+        );
         if std::env::var("MG_EXACT").is_ok() {
             // Exhaustive 0- and 1-cut paths (leaf edges) to the first constraint alone.
             let b1 = &pb.body[1];
@@ -136,14 +140,14 @@ fn main() -> motion_graph::Result<()> {
                 if beam_only.is_none() {
                     s.run_until(&tol, std::time::Duration::from_secs_f64(4.0), 100_000);
                 }
-                let b = s.best().unwrap();
+                let b = s.best().expect("Search::new seeds a non-empty population or errors");
                 let e: Vec<String> = b.errors.body_pos.iter().skip(1).map(|x| format!("{x:.2}")).collect();
                 println!(
                     "  prefix {j}: {:.2} s, {} it, err [{}], yaw {:.1}°",
                     t.elapsed().as_secs_f64(),
                     s.iterations(),
                     e.join(" "),
-                    b.errors.body_yaw_deg.last().unwrap()
+                    b.errors.body_yaw_deg.last().copied().unwrap_or(f64::NAN)
                 );
             }
             continue;
@@ -163,14 +167,14 @@ fn main() -> motion_graph::Result<()> {
                     ..Default::default()
                 };
                 let s = Search::new(&g, pb.clone(), sp)?;
-                let b = s.best().unwrap();
+                let b = s.best().expect("Search::new seeds a non-empty population or errors");
                 let e: Vec<String> = b.errors.body_pos.iter().skip(1).map(|x| format!("{x:.2}")).collect();
                 println!(
                     "  width {w:4} run {r}: {:.3} s, score {:.2}, err [{}], yaw {:.1}°, pop {}",
                     t.elapsed().as_secs_f64(),
                     b.score,
                     e.join(" "),
-                    b.errors.body_yaw_deg.last().unwrap(),
+                    b.errors.body_yaw_deg.last().copied().unwrap_or(f64::NAN),
                     s.population().len()
                 );
             }
