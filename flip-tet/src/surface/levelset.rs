@@ -2,6 +2,7 @@
 //! triplet-hull union near the surface, coarse sphere union elsewhere, interior redistancing by
 //! edge-path distance, mirrored particles at closed box walls, extension into obstacles.
 
+use std::borrow::Cow;
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::sync::OnceLock;
@@ -382,6 +383,15 @@ pub fn node_edges(mesh: &TetMesh) -> Ragged<u32> {
     Ragged::from_pairs(mesh.nodes.len(), &pairs)
 }
 
+/// The node sizes and edge lists the level set needs: the mesh's caches (`node_h`, `node_nbrs`,
+/// filled by `compute_geometry`), or computed here for meshes built without them.
+fn sizes_and_edges(mesh: &TetMesh) -> (Cow<'_, [f64]>, Cow<'_, Ragged<u32>>) {
+    let n = mesh.nodes.len();
+    let h = if mesh.node_h.len() == n { Cow::Borrowed(&mesh.node_h[..]) } else { Cow::Owned(node_sizes(mesh)) };
+    let e = if mesh.node_nbrs.len() == n { Cow::Borrowed(&mesh.node_nbrs) } else { Cow::Owned(node_edges(mesh)) };
+    (h, e)
+}
+
 /// Liquid level set at every mesh node (m, negative inside), spec §3.11.3: the method of
 /// `params.method` within the band `max(3 h, 6 r_max)`, clamped outside it, then interior
 /// redistancing (every value `≤ −band` replaced by minus the multi-source shortest edge-path
@@ -397,24 +407,10 @@ pub fn node_edges(mesh: &TetMesh) -> Ragged<u32> {
 /// caches (`node_h`, `node_nbrs`) when filled.
 pub fn level_set_on_nodes(mesh: &TetMesh, parts: &Particles, params: &SurfaceParams, walls: &Walls) -> Vec<f64> {
     let sampler = LevelSetSampler::new(parts, params, walls);
-    let n = mesh.nodes.len();
-    // The mesh caches both (filled by `compute_geometry`); meshes built without it get them here.
-    let h_own;
-    let h: &[f64] = if mesh.node_h.len() == n {
-        &mesh.node_h
-    } else {
-        h_own = node_sizes(mesh);
-        &h_own
-    };
+    let (h, edges) = sizes_and_edges(mesh);
+    let (h, edges) = (&h[..], &*edges);
     let mut phi: Vec<f64> =
         mesh.nodes.par_iter().zip(h.par_iter()).map(|(q, &hq)| sampler.value_on_node(q, hq)).collect();
-    let edges_own;
-    let edges: &Ragged<u32> = if mesh.node_nbrs.len() == n {
-        &mesh.node_nbrs
-    } else {
-        edges_own = node_edges(mesh);
-        &edges_own
-    };
     let bands: Vec<f64> = h.iter().map(|&hq| sampler.band(hq)).collect();
     redistance_interior(&mesh.nodes, edges, &bands, &mut phi);
     if let Some(solid) = walls.node_in_solid {
@@ -452,20 +448,8 @@ pub fn level_set_on_nodes_sign_inside(
     }
     let sampler = LevelSetSampler::new(parts, params, walls);
     let n = mesh.nodes.len();
-    let h_own;
-    let h: &[f64] = if mesh.node_h.len() == n {
-        &mesh.node_h
-    } else {
-        h_own = node_sizes(mesh);
-        &h_own
-    };
-    let edges_own;
-    let edges: &Ragged<u32> = if mesh.node_nbrs.len() == n {
-        &mesh.node_nbrs
-    } else {
-        edges_own = node_edges(mesh);
-        &edges_own
-    };
+    let (h, edges) = sizes_and_edges(mesh);
+    let (h, edges) = (&h[..], &*edges);
     let first: Vec<(f64, bool)> =
         mesh.nodes.par_iter().zip(h.par_iter()).map(|(q, &hq)| sampler.value_on_node_or_inside(q, hq)).collect();
     let mut phi: Vec<f64> = first.iter().map(|v| v.0).collect();

@@ -850,6 +850,19 @@ pub use geom_core::query::tri_tri_intersect;
 mod tests {
     use super::*;
 
+    /// Triangles of an n × n vertex grid (row-major vertices, two triangles per cell).
+    fn grid_triangles(n: usize) -> Vec<[u32; 3]> {
+        let mut f = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let a = (j * n + i) as u32;
+                f.push([a, a + 1, a + n as u32 + 1]);
+                f.push([a, a + n as u32 + 1, a + n as u32]);
+            }
+        }
+        f
+    }
+
     /// The incremental CCD of later calls in one filter call equals a full recomputation (same
     /// stencils bit for bit, same order), on a crumpled, self-overlapping random sheet whose
     /// velocities change on a few vertices between calls, as CCD passes and impact zones do.
@@ -866,14 +879,7 @@ mod tests {
                 p.push(Pt3::new(x, 0.3 * (6.0 * y).sin(), 0.05 * (y * 9.0).cos() + 0.01 * rng.range(-1.0, 1.0)));
             }
         }
-        let mut f = Vec::new();
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let a = (j * n + i) as u32;
-                f.push([a, a + 1, a + n as u32 + 1]);
-                f.push([a, a + n as u32 + 1, a + n as u32]);
-            }
-        }
+        let f = grid_triangles(n);
         let mesh = ShellMesh::new(p.clone(), &f, None, &Material::cotton()).expect("valid grid");
         let effects = Effects { self_collision: true, ..Effects::default() };
         let cs = CollisionSettings::default();
@@ -948,14 +954,7 @@ mod tests {
                 p.push(Pt3::new(x, y, z));
             }
         }
-        let mut f = Vec::new();
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let a = (j * n + i) as u32;
-                f.push([a, a + 1, a + n as u32 + 1]);
-                f.push([a, a + n as u32 + 1, a + n as u32]);
-            }
-        }
+        let f = grid_triangles(n);
         let mesh = ShellMesh::new(p.clone(), &f, None, &Material::cotton()).expect("valid folded grid");
         let effects = Effects { self_collision: true, ..Effects::default() };
         let c = Collider::new(&mesh, &effects, &CollisionSettings::default(), 1.0);
