@@ -398,23 +398,17 @@ impl Beam<'_> {
         let g = self.g;
         let cost = |e: EdgeId| self.cp.pb.weights.cut * g.edges[e as usize].cost as f64;
         let plus = |x: f64| (s.acc + x, s.racc + x);
+        // Evaluates the state reached by `n` cuts through `fill` (cut cost `cut`) and keeps it
+        // when it can still meet checkpoint `c`.
+        let keep =
+            |out: &mut Vec<Ext>, cut: f64, fill: [EdgeId; 2], n: u8, to: (u32, u32, u32, Rigid2), jitter: f64| {
+                let (clip, a, ta, w) = to;
+                if let Some((acc, racc, rank, rank2, frame)) = self.eval(c, plus(cut), clip, a, ta, &w, jitter) {
+                    out.push(Ext { rank, rank2, acc, racc, parent: si, fill, n, clip, a, ta, w, frame });
+                }
+            };
         // 0 cuts: stay in the piece.
-        if let Some((acc, racc, rank, rank2, frame)) = self.eval(c, plus(0.0), s.clip, s.a, s.ta, &s.w, rng.f64()) {
-            out.push(Ext {
-                rank,
-                rank2,
-                acc,
-                racc,
-                parent: si,
-                fill: [0; 2],
-                n: 0,
-                clip: s.clip,
-                a: s.a,
-                ta: s.ta,
-                w: s.w,
-                frame,
-            });
-        }
+        keep(out, 0.0, [0; 2], 0, (s.clip, s.a, s.ta, s.w), rng.f64());
         // Leaving at frame i plays the entered frame at ta + i − a + 1 ≤ t_c.
         let Some(hi) = (s.a + (c.t - s.ta)).checked_sub(1) else { return };
         let (lo1, hi1) = self.leaves(s.clip, s.min_from, hi);
@@ -422,10 +416,7 @@ impl Beam<'_> {
         // 1 cut: every leaf edge, or `one_cut_draws` of them drawn uniformly when there are more
         // (dense graphs).
         let one = |e: EdgeId, out: &mut Vec<Ext>, jitter: f64| {
-            let (clip, a, ta, w) = self.follow(e, s.a, s.ta, &s.w);
-            if let Some((acc, racc, rank, rank2, frame)) = self.eval(c, plus(cost(e)), clip, a, ta, &w, jitter) {
-                out.push(Ext { rank, rank2, acc, racc, parent: si, fill: [e, 0], n: 1, clip, a, ta, w, frame });
-            }
+            keep(out, cost(e), [e, 0], 1, self.follow(e, s.a, s.ta, &s.w), jitter);
         };
         let n1 = hi1 - lo1;
         if self.gp.one_cut_draws == 0 || n1 <= self.gp.one_cut_draws || c.hard.is_some() {
@@ -452,26 +443,8 @@ impl Beam<'_> {
                     let fr = |e: &EdgeId| g.edges[*e as usize].from.frame;
                     let lo = es.partition_point(|e| fr(e) < a1 + self.minp - 1);
                     for &e2 in es[lo..].iter().take_while(|e| fr(e) <= hi2) {
-                        let (clip, a, ta, w) = self.follow(e2, a1, t1, &w1);
-                        let jit = rng.f64();
-                        if let Some((acc, racc, rank, rank2, frame)) =
-                            self.eval(c, plus(cost(e1) + cost(e2)), clip, a, ta, &w, jit)
-                        {
-                            out.push(Ext {
-                                rank,
-                                rank2,
-                                acc,
-                                racc,
-                                parent: si,
-                                fill: [e1, e2],
-                                n: 2,
-                                clip,
-                                a,
-                                ta,
-                                w,
-                                frame,
-                            });
-                        }
+                        let to = self.follow(e2, a1, t1, &w1);
+                        keep(out, cost(e1) + cost(e2), [e1, e2], 2, to, rng.f64());
                     }
                 }
             }
@@ -492,12 +465,7 @@ impl Beam<'_> {
                 continue;
             }
             let take = |e2: EdgeId, out: &mut Vec<Ext>, jitter: f64| {
-                let (clip, a, ta, w) = self.follow(e2, a1, t1, &w1);
-                if let Some((acc, racc, rank, rank2, frame)) =
-                    self.eval(c, plus(cost(e1) + cost(e2)), clip, a, ta, &w, jitter)
-                {
-                    out.push(Ext { rank, rank2, acc, racc, parent: si, fill: [e1, e2], n: 2, clip, a, ta, w, frame });
-                }
+                keep(out, cost(e1) + cost(e2), [e1, e2], 2, self.follow(e2, a1, t1, &w1), jitter);
             };
             if c.hard.is_some() {
                 for &e2 in &outs2[lo2..hi2] {
