@@ -326,6 +326,48 @@ fn ldlt_rejects_bad_regularization() {
 }
 
 #[test]
+fn block_amd_keeps_blocks_together_and_solves() {
+    // Blocks of the 2-D KKT system: primal pairs (2i, 2i + 1) and the multipliers one by one.
+    let (k, n, m) = kkt_system();
+    let kc = k.to_csc_lower();
+    let mut block: Vec<u32> = (0..n as u32).map(|i| i / 2).collect();
+    block.extend((0..m as u32).map(|r| n as u32 / 2 + r));
+    let mut f = SparseLdlt::analyze(&kc, Ordering::AmdBlocks(block.clone())).expect("analysis");
+    let perm = f.perm().to_vec();
+    let mut sorted = perm.clone();
+    sorted.sort_unstable();
+    assert_eq!(sorted, (0..n + m).collect::<Vec<_>>(), "a permutation");
+    for w in perm.windows(2) {
+        // Rows of one block are consecutive and ascending; a block never reappears later.
+        if block[w[0]] == block[w[1]] {
+            assert_eq!(w[1], w[0] + 1);
+        }
+    }
+    let firsts: Vec<u32> = perm.iter().map(|&i| block[i]).collect();
+    let mut seen = std::collections::HashSet::new();
+    let mut prev = u32::MAX;
+    for b in firsts {
+        if b != prev {
+            assert!(seen.insert(b), "block {b} split");
+            prev = b;
+        }
+    }
+    f.factor(&kc, &Regularization::kkt(n, m)).expect("LDLT");
+    let b = test_vector(n + m, 8);
+    let mut x = vec![0.0; n + m];
+    let r = f.solve_refined(&kc, &b, &mut x, 2).expect("solve");
+    assert!(r <= 1e-14, "residual {r:e}");
+    // Bad block vectors: wrong length, an unused id.
+    assert!(matches!(
+        SparseLdlt::analyze(&kc, Ordering::AmdBlocks(block[1..].to_vec())),
+        Err(Error::DimensionMismatch { .. })
+    ));
+    let mut gap = block;
+    gap[0] = (n + m) as u32 + 5;
+    assert!(matches!(SparseLdlt::analyze(&kc, Ordering::AmdBlocks(gap)), Err(Error::InvalidParameter(_))));
+}
+
+#[test]
 fn ldlt_custom_order_puts_constraints_last() {
     // Tracks' recipe: AMD order of the primal block, then the multipliers.
     let (k, n, m) = kkt_system();

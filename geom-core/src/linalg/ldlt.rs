@@ -191,6 +191,21 @@ impl SparseLdlt {
         }
         x.copy_from_slice(b);
         self.solve_in_place(x)?;
+        self.refine(k, b, x, steps)
+    }
+
+    /// `steps` rounds of iterative refinement `x ← x + K̃⁻¹ (b − K x)` of a given approximate
+    /// solution `x` of `K x = b` (e.g. a solve with a warm-started right-hand side); returns
+    /// the final relative residual like [`SparseLdlt::solve_refined`].
+    pub fn refine(&self, k: &Csc, b: &[f64], x: &mut [f64], steps: u32) -> Result<f64> {
+        let n = self.symbolic.n();
+        if k.nrows() != n || k.ncols() != n || b.len() != n || x.len() != n {
+            return Err(Error::DimensionMismatch {
+                what: "SparseLdlt::refine: matrix, b or x",
+                expected: n,
+                got: x.len(),
+            });
+        }
         let mut r = vec![0.0; n];
         let residual = |x: &[f64], r: &mut [f64]| {
             sym_mul_vec(k, x, r);

@@ -7,10 +7,13 @@
 
 use super::csc::Csc;
 use crate::error::{Error, Result};
+use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::perm::PermRef;
+use faer::sparse::linalg::amd;
 use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymmetricOrdering,
 };
+use faer::sparse::SymbolicSparseColMat;
 use faer::Side;
 use std::sync::Arc;
 
@@ -26,6 +29,16 @@ pub enum Ordering {
     /// `k`-th. Used to put constraint rows last in a KKT system (tracks) by extending the
     /// primal block's AMD order ([`super::SparseLlt::perm`]).
     Custom(Vec<usize>),
+    /// AMD on the quotient graph of blocks of rows: `block[i]` is the block of row/column `i`
+    /// (ids `0..=max`, every id used); each block's rows are eliminated consecutively, in
+    /// ascending order. For matrices whose rows come in groups with nearly the same pattern —
+    /// the three coordinates of a vertex, the three multipliers of a region constraint in a KKT
+    /// system — ordering whole groups keeps the factor's supernodes whole where scalar AMD may
+    /// split them (a multiplier row couples to one coordinate only, so the three coordinates of
+    /// a vertex are no longer indistinguishable to scalar AMD). Measured on the tracks Xavier
+    /// KKT system (9114 DOFs, 840 multipliers): nnz(L) 2.56 M against 2.80 M, factorisation
+    /// 10 % faster, a third of the analysis time.
+    AmdBlocks(Vec<u32>),
 }
 
 /// The shared, immutable part of a symbolic analysis.
@@ -69,19 +82,23 @@ impl LltSymbolic {
         // faer 0.24.4's `SymmetricOrdering::Identity` analyses the given triangle as if it were
         // the upper one (wrong elimination tree for `Side::Lower`, then an index panic), so the
         // natural order is passed as an explicit identity permutation.
-        let identity: Vec<usize>;
+        let computed: Vec<usize>;
         let custom: &[usize] = match ordering {
             Ordering::Amd => &[],
             Ordering::Natural => {
-                identity = (0..n).collect();
-                &identity
+                computed = (0..n).collect();
+                &computed
             }
             Ordering::Custom(p) => p,
+            Ordering::AmdBlocks(block) => {
+                computed = block_amd(a, block)?;
+                &computed
+            }
         };
         let custom_inv;
         let ord = match ordering {
             Ordering::Amd => SymmetricOrdering::Amd,
-            Ordering::Natural | Ordering::Custom(_) => {
+            Ordering::Natural | Ordering::Custom(_) | Ordering::AmdBlocks(_) => {
                 custom_inv = inverse_permutation(custom, n)?;
                 SymmetricOrdering::Custom(PermRef::new_checked(custom, &custom_inv, n))
             }
@@ -147,6 +164,55 @@ impl LltSymbolic {
         }
         Ok(())
     }
+}
+
+/// The scalar elimination order of [`Ordering::AmdBlocks`]: faer's AMD on the graph whose nodes
+/// are the blocks (an edge where any entry of `a`, either triangle, joins two blocks), each
+/// block expanded to its rows in ascending order.
+fn block_amd(a: &Csc, block: &[u32]) -> Result<Vec<usize>> {
+    let n = a.nrows();
+    if block.len() != n {
+        return Err(Error::DimensionMismatch { what: "Ordering::AmdBlocks block ids", expected: n, got: block.len() });
+    }
+    let nb = block.iter().map(|&b| b as usize + 1).max().unwrap_or(0);
+    let mut members: Vec<Vec<usize>> = vec![Vec::new(); nb];
+    for (i, &b) in block.iter().enumerate() {
+        members[b as usize].push(i);
+    }
+    if let Some(b) = members.iter().position(Vec::is_empty) {
+        return Err(Error::InvalidParameter(format!(
+            "Ordering::AmdBlocks: block id {b} has no rows (ids must be 0..{nb} with every id used)"
+        )));
+    }
+    let sym = a.symbolic();
+    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); nb];
+    for j in 0..n {
+        let bj = block[j] as usize;
+        for &i in sym.row_idx_of_col_raw(j) {
+            let bi = block[i] as usize;
+            if bi != bj {
+                adj[bi].push(bj);
+                adj[bj].push(bi);
+            }
+        }
+    }
+    let mut col_ptr = Vec::with_capacity(nb + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for list in &mut adj {
+        list.sort_unstable();
+        list.dedup();
+        row_idx.extend_from_slice(list);
+        col_ptr.push(row_idx.len());
+    }
+    let graph = SymbolicSparseColMat::new_checked(nb, nb, col_ptr, None, row_idx);
+    let mut perm = vec![0usize; nb];
+    let mut perm_inv = vec![0usize; nb];
+    let mut mem = MemBuffer::try_new(amd::order_scratch::<usize>(nb, graph.compute_nnz()))
+        .map_err(|_| Error::Factorization("Ordering::AmdBlocks: out of memory for AMD scratch".into()))?;
+    amd::order(&mut perm, &mut perm_inv, graph.as_ref(), amd::Control::default(), MemStack::new(&mut mem))
+        .map_err(|e| Error::Factorization(format!("Ordering::AmdBlocks: AMD failed: {e:?}")))?;
+    Ok(perm.iter().flat_map(|&b| members[b].iter().copied()).collect())
 }
 
 /// Checks that `p` is a permutation of `0..n` and returns its inverse.
