@@ -66,6 +66,8 @@ pub struct TrackStepStats {
     pub max_constraint_force: f64,
     /// Relative residual of the KKT solve after refinement.
     pub kkt_refinement_residual: f64,
+    /// Refinement steps the constrained solve took.
+    pub kkt_refine_steps: u32,
     /// Guide held past its end at this step.
     pub guide_held: bool,
     /// Stored entries of the factor used by the constrained solve.
@@ -240,6 +242,7 @@ impl Tracker {
                 out.residual_pre_collision = l.residual_pre;
                 out.max_constraint_force = l.max_constraint_force;
                 out.kkt_refinement_residual = l.refinement_residual;
+                out.kkt_refine_steps = l.refine_steps_done;
                 out.guide_held = l.guide_held;
                 out.nnz_l = l.nnz_l;
                 out.compare = l.compare.clone();

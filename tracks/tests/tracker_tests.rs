@@ -370,3 +370,26 @@ fn unrefined_shift_is_warm_started() {
     let d = v_amd.iter().zip(&v_exact).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
     assert!(d <= 1e-6 * scale, "unrefined AMD differs from the exact solve by {d} (scale {scale})");
 }
+
+/// AmdRegularizedLdlt with a coarse shift (δ = 1e-6) and `refine_steps: 0`: the warm-started
+/// solve misses the constraints by more than `SHIFT_RESIDUAL_TOL`·L, so the solver adds a
+/// refinement step by itself; r_pre stays ≤ 1e-10·L at every step.
+#[test]
+fn shift_residual_test_adds_refinement() {
+    let c = coarse();
+    let (fine, p) = subdivide_linear(&c, 2);
+    let g = waving_guide(&c);
+    let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
+    let sim = sim_of(&fine, true, 0.0, vec![], Vec3::zeros());
+    let l = g.scale();
+    let opts =
+        TrackOptions { kkt: KktMethod::AmdRegularizedLdlt { delta: 1e-6 }, refine_steps: 0, ..TrackOptions::default() };
+    let mut tr = Tracker::new(sim, g, tf, Some(p), opts).expect("tracker");
+    let mut refined = 0;
+    for _ in 0..20 {
+        let s = tr.step(1.0 / 120.0).expect("step");
+        assert!(s.residual_pre_collision <= 1e-10 * l, "r_pre {:e} (L = {l})", s.residual_pre_collision);
+        refined += usize::from(s.kkt_refine_steps > 0);
+    }
+    assert!(refined > 0, "the coarse shift never triggered a refinement");
+}
