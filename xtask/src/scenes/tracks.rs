@@ -67,7 +67,7 @@ fn core<T>(r: geom_core::Result<T>) -> Result<T> {
 
 /// Isotropic St Venant–Kirchhoff shell: areal density (kg/m²), Young's modulus × thickness (N/m),
 /// Poisson ratio, bending stiffness (N·m) and Rayleigh stiffness damping β (s).
-fn iso_material(density: f64, young_thickness: f64, poisson: f64, bending: f64, beta: f64) -> Material {
+pub(crate) fn iso_material(density: f64, young_thickness: f64, poisson: f64, bending: f64, beta: f64) -> Material {
     Material {
         density,
         membrane: MembraneLaw::Isotropic { young_thickness, poisson, compression_softening: None },
@@ -77,11 +77,11 @@ fn iso_material(density: f64, young_thickness: f64, poisson: f64, bending: f64, 
     }
 }
 
-fn rubber() -> Material {
+pub(crate) fn rubber() -> Material {
     iso_material(0.5, 2.0e4, 0.4, 2e-4, 1e-3)
 }
 
-fn vinyl() -> Material {
+pub(crate) fn vinyl() -> Material {
     iso_material(0.3, 5.0e3, 0.35, 5e-5, 5e-3)
 }
 
@@ -177,6 +177,8 @@ pub(crate) struct PairOut {
     pub final_tracked: Vec<Pt3>,
     pub final_untracked: Vec<Pt3>,
     pub ke_tracked: Vec<f64>,
+    /// Detail wavelength λ_eff = 2π sqrt(hᵀM_L h / hᵀK h) of h = d − L_τ d per frame ≥ 1 (spec §3.8).
+    pub lambda_eff_tracked: Vec<f64>,
     pub step_times: Vec<(f64, f64)>,
     /// Per method of `TrackOptions::compare`: Σ solve time (s), max relative Δv difference to
     /// the main solve, stored factor entries.
@@ -269,7 +271,18 @@ pub(crate) fn run_pair(setup: &Setup, o: &PairOpts, out_dir: &Path) -> Result<Pa
     let tag = &o.tag;
     let mut steps_csv = CsvWriter::create(
         &out_dir.join(format!("steps{tag}.csv")),
-        &["t", "t_step_tracked", "t_step_untracked", "t_kkt", "t_shadow_llt", "r_pre", "r_post", "max_force", "ccd"],
+        &[
+            "t",
+            "t_step_tracked",
+            "t_step_untracked",
+            "t_kkt",
+            "t_shadow_llt",
+            "r_pre",
+            "r_post",
+            "max_force",
+            "ccd",
+            "refine_steps",
+        ],
     )?;
     let mut frames_csv = CsvWriter::create(
         &out_dir.join(format!("frames{tag}.csv")),
@@ -310,6 +323,7 @@ pub(crate) fn run_pair(setup: &Setup, o: &PairOpts, out_dir: &Path) -> Result<Pa
                     Cell::Num(st.residual_post_collision),
                     Cell::Num(st.max_constraint_force),
                     Cell::Int(st.shell.n_ccd as i64),
+                    Cell::Int(i64::from(st.kkt_refine_steps)),
                 ])?;
             }
             out.frames += 1;
@@ -346,6 +360,9 @@ pub(crate) fn run_pair(setup: &Setup, o: &PairOpts, out_dir: &Path) -> Result<Pa
             out.ad_tracked.push(ad);
             out.rms_tracked.push(rms);
             out.lambda_raw_tracked.push(lp.wavelength(&d));
+            let lo = tk(lp.apply(&d))?;
+            let detail: Vec<Vec3> = d.iter().zip(&lo).map(|(a, b)| a - b).collect();
+            out.lambda_eff_tracked.push(lp.wavelength(&detail));
         }
         out.bend_tracked.push(bend);
         out.tug_tracked.push(tug);
@@ -392,11 +409,11 @@ fn plot_pair(out: &PairOut, dir: &Path, title: &str) -> Result<()> {
     Ok(())
 }
 
-fn pick3<T: Copy>(m: Mode, v: (T, T, T)) -> T {
+pub(crate) fn pick3<T: Copy>(m: Mode, v: (T, T, T)) -> T {
     m.pick(v.0, v.1, v.2)
 }
 
-fn frames_for(duration: f64, fps: f64) -> usize {
+pub(crate) fn frames_for(duration: f64, fps: f64) -> usize {
     (duration * fps).round().max(1.0) as usize
 }
 
@@ -420,7 +437,7 @@ struct PairParams {
     obj_every: usize,
 }
 
-fn track_opts(kkt: KktMethod, refine_steps: u32) -> TrackOptions {
+pub(crate) fn track_opts(kkt: KktMethod, refine_steps: u32) -> TrackOptions {
     TrackOptions { kkt, refine_steps, ..TrackOptions::default() }
 }
 
