@@ -32,6 +32,11 @@ pub struct TrackOptions {
     /// compared with the main solve): measures the alternatives on identical matrices in one
     /// run (spec §3.6, issue 4). Costs their time; keep empty in overhead runs.
     pub compare: Vec<KktMethod>,
+    /// After the collision pass, correct the velocities by the smallest mass-weighted change
+    /// that removes the constraint residual, v ← v + W Ĉᵀ G⁻¹ g(q_{k+1}) / h, and rerun only the
+    /// collision pass on it ([`ShellSim::recollide`]), so collision-freedom keeps priority
+    /// (spec §3.7 step 5). Costs one collision pass per step when the residual is non-zero.
+    pub reproject_after_collisions: bool,
 }
 
 impl Default for TrackOptions {
@@ -43,6 +48,7 @@ impl Default for TrackOptions {
             refine_steps: 1,
             shadow_timing: false,
             compare: Vec::new(),
+            reproject_after_collisions: false,
         }
     }
 }
@@ -68,6 +74,11 @@ pub struct TrackStepStats {
     pub kkt_refinement_residual: f64,
     /// Refinement steps the constrained solve took.
     pub kkt_refine_steps: u32,
+    /// max_i ‖g_i‖ after the first collision pass (m), before the reprojection of
+    /// [`TrackOptions::reproject_after_collisions`]; equals `residual_post_collision` without it.
+    pub residual_post_first_pass: f64,
+    /// The reprojection ran (option on and a non-zero post-collision residual).
+    pub reprojected: bool,
     /// Guide held past its end at this step.
     pub guide_held: bool,
     /// Stored entries of the factor used by the constrained solve.
@@ -91,6 +102,11 @@ pub struct Tracker {
     /// Setup warnings (dropped rows, …).
     pub warnings: Vec<String>,
     gram: Option<GramFactor>,
+    /// Inverse masses of free vertices, 0 for pinned/kinematic ones (the W of §3.5).
+    w: Vec<f64>,
+    reproject: bool,
+    /// The guide's bounding-box diagonal L at t = 0 (m).
+    scale: f64,
     gbuf: Vec<Pt3>,
 }
 
@@ -161,9 +177,22 @@ impl Tracker {
         } else {
             Some(TrackingSolver::new(cons, guide.clone(), &opts, sim.fill_reducing_perm().to_vec(), sim.llt_symbolic()))
         };
-        let mut tr = Self { sim, guide, prolongation, solver, dropped_rows: pinned_rows, warnings, gram, gbuf };
+        let reproject = opts.reproject_after_collisions;
+        let mut tr = Self {
+            sim,
+            guide,
+            prolongation,
+            solver,
+            dropped_rows: pinned_rows,
+            warnings,
+            gram,
+            w,
+            reproject,
+            scale,
+            gbuf,
+        };
         if opts.project_initial_state && tr.solver.is_some() {
-            tr.project_initial_state(&w)?;
+            tr.project_initial_state()?;
         }
         Ok(tr)
     }
@@ -175,10 +204,9 @@ impl Tracker {
 
     /// Smallest mass-weighted correction of (q₀, v₀) with g₀ = 0 and ġ₀ = 0 (§3.5):
     /// q₀ += W C_fᵀ G⁻¹ g₀, v₀ += W C_fᵀ G⁻¹ (C̄ q̄̇(0) − C v₀).
-    fn project_initial_state(&mut self, w: &[f64]) -> Result<()> {
-        let (cons, gram) = match (self.solver.as_ref(), self.gram.as_ref()) {
-            (Some(s), Some(g)) => (s.constraints().clone(), g.clone()),
-            _ => return Ok(()),
+    fn project_initial_state(&mut self) -> Result<()> {
+        let Some(cons) = self.solver.as_ref().map(|s| s.constraints().clone()) else {
+            return Ok(());
         };
         let st = self.sim.state().clone();
         let k = cons.len();
@@ -191,27 +219,55 @@ impl Tracker {
         let v_pt: Vec<Pt3> = st.v.iter().map(|v| Pt3::from(*v)).collect();
         let mut gv = vec![Vec3::zeros(); k];
         cons.residual(&vb_pt, &v_pt, &mut gv);
-        let ct = cons.c.transpose();
-        let correct = |g: &[Vec3]| -> Vec<Vec3> {
-            let mut out = vec![Vec3::zeros(); w.len()];
-            for d in 0..3 {
-                let mut y: Vec<f64> = g.iter().map(|x| x[d]).collect();
-                gram.solve(&mut y);
-                for (l, o) in out.iter_mut().enumerate() {
-                    if w[l] > 0.0 {
-                        let (rows, vals) = ct.row(l);
-                        o[d] = w[l] * rows.iter().zip(vals).map(|(&i, &c)| c * y[i as usize]).sum::<f64>();
-                    }
-                }
-            }
-            out
-        };
-        let dq = correct(&gq);
-        let dv = correct(&gv);
+        let dq = self.mass_weighted_correction(&cons, &gq);
+        let dv = self.mass_weighted_correction(&cons, &gv);
         let q: Vec<Pt3> = st.q.iter().zip(&dq).map(|(p, d)| p + d).collect();
         let v: Vec<Vec3> = st.v.iter().zip(&dv).map(|(p, d)| p + d).collect();
         self.sim.set_state(ShellState { t: st.t, q, v })?;
         Ok(())
+    }
+
+    /// The smallest correction Δ in the mass metric with C Δ = g per coordinate:
+    /// Δ = W Cᵀ G⁻¹ g, G = C W Cᵀ (the cached Gram factor), zero on pinned vertices.
+    fn mass_weighted_correction(&self, cons: &TrackingConstraints, g: &[Vec3]) -> Vec<Vec3> {
+        let w = &self.w;
+        let mut out = vec![Vec3::zeros(); w.len()];
+        let Some(gram) = self.gram.as_ref() else {
+            return out;
+        };
+        let ct = cons.c.transpose();
+        for d in 0..3 {
+            let mut y: Vec<f64> = g.iter().map(|x| x[d]).collect();
+            gram.solve(&mut y);
+            for (l, o) in out.iter_mut().enumerate() {
+                if w[l] > 0.0 {
+                    let (rows, vals) = ct.row(l);
+                    o[d] = w[l] * rows.iter().zip(vals).map(|(&i, &c)| c * y[i as usize]).sum::<f64>();
+                }
+            }
+        }
+        out
+    }
+
+    /// §3.7 step 5: velocities corrected by W Ĉᵀ G⁻¹ g(q_{k+1}) / h, then the collision pass
+    /// again from q_k ([`ShellSim::recollide`]). Returns whether it ran (not when every
+    /// ‖g_i‖ ≤ 1e-12·L).
+    fn reproject_after_collisions(&mut self, h: f64) -> Result<bool> {
+        let Some(cons) = self.solver.as_ref().map(|s| s.constraints().clone()) else {
+            return Ok(false);
+        };
+        let st = self.sim.state();
+        self.guide.sample(st.t, &mut self.gbuf);
+        let mut g = vec![Vec3::zeros(); cons.len()];
+        cons.residual(&self.gbuf, &st.q, &mut g);
+        // Already at solver precision (spec: r ≈ 1e-13·L): nothing to correct.
+        if g.iter().all(|x| x.norm() <= 1e-12 * self.scale) {
+            return Ok(false);
+        }
+        let dq = self.mass_weighted_correction(&cons, &g);
+        let v: Vec<Vec3> = self.sim.state().v.iter().zip(&dq).map(|(v, d)| v + d / h).collect();
+        self.sim.recollide(&v)?;
+        Ok(true)
     }
 
     /// Current constraint residual max_i ‖g_i(q, t)‖ (m); 0 when K = 0.
@@ -248,8 +304,15 @@ impl Tracker {
                 out.compare = l.compare.clone();
             }
         }
+        if self.reproject {
+            out.residual_post_first_pass = self.residual_now();
+            out.reprojected = self.reproject_after_collisions(h)?;
+        }
         out.t_step = t0.elapsed().as_secs_f64();
         out.residual_post_collision = self.residual_now();
+        if !self.reproject {
+            out.residual_post_first_pass = out.residual_post_collision;
+        }
         Ok(out)
     }
 }

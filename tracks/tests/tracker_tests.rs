@@ -393,3 +393,73 @@ fn shift_residual_test_adds_refinement() {
     }
     assert!(refined > 0, "the coarse shift never triggered a refinement");
 }
+
+/// §3.7 step 5 (`reproject_after_collisions`) on the waving sheet (the guide dips to y ≈ −0.093 m)
+/// over a ground plane. After the collision pass the velocities are corrected by W Ĉᵀ G⁻¹ g / h
+/// and the collision pass is rerun, so collision-freedom keeps priority: no vertex ever ends below
+/// the plane. (a) Floor at −0.095 m, initial state projected: contact only grazes the tracked
+/// sheet at the start, the constraints stay feasible, and the reprojection removes most of what
+/// the collision pass left (measured over 120 steps: mean r_post 2.2e-6 → 7.6e-7 m). (b) Floor at
+/// −0.05 m, flat start: the guide asks for positions inside the floor — an infeasible conflict —
+/// and the residual stays (1.12e-2 → 1.11e-2 m): the correction is undone by the rerun pass
+/// instead of pushing the cloth through.
+#[test]
+fn reprojection_after_collisions() {
+    use shells::{CollisionSettings, Obstacle, ObstacleShape};
+    let run = |floor: f64, project: bool, reproject: bool| {
+        let c = coarse();
+        let (fine, p) = subdivide_linear(&c, 2);
+        let g = waving_guide(&c);
+        let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
+        let mut mat = Material::cotton();
+        mat.damping = Damping::Rayleigh { alpha: 0.0, beta: 1e-4 };
+        let plane =
+            Obstacle { shape: ObstacleShape::Plane { normal: Vec3::y(), offset: floor }, friction: 0.5, motion: None };
+        let effects = Effects {
+            gravity: Some(Vec3::new(0.0, -9.81, 0.0)),
+            obstacles: vec![plane],
+            collision: Some(CollisionSettings::default()),
+            ..Effects::default()
+        };
+        let sim = ShellSim::new(ShellSceneDesc {
+            rest: fine.positions.clone(),
+            faces: fine.faces.clone(),
+            uv: None,
+            initial: None,
+            initial_velocity: None,
+            material: mat,
+            effects,
+            constraints: vec![],
+            integrator: IntegratorSettings::default(),
+            t0: 0.0,
+        })
+        .expect("valid sim");
+        let opts = TrackOptions {
+            reproject_after_collisions: reproject,
+            project_initial_state: project,
+            ..TrackOptions::default()
+        };
+        let mut tr = Tracker::new(sim, g, tf, Some(p), opts).expect("tracker");
+        let (mut first, mut last, mut ran) = (0.0, 0.0, 0);
+        for _ in 0..120 {
+            let s = tr.step(1.0 / 120.0).expect("step");
+            first += s.residual_post_first_pass;
+            last += s.residual_post_collision;
+            ran += usize::from(s.reprojected);
+            let low = tr.sim.state().q.iter().map(|q| q.y).fold(f64::INFINITY, f64::min);
+            assert!(low >= floor - 1e-9, "vertex at y = {low} below the floor {floor} at t = {}", tr.sim.state().t);
+        }
+        (first / 120.0, last / 120.0, ran)
+    };
+    // Option off: nothing runs, both residuals are the same number.
+    let (first, last, ran) = run(-0.095, true, false);
+    assert_eq!((ran, first), (0, last));
+    // (a) feasible: the reprojection removes at least half of the post-collision residual.
+    let (first, last, ran) = run(-0.095, true, true);
+    assert!(ran > 0 && first > 1e-7, "contact must disturb the tracking (ran {ran}, r {first:e})");
+    assert!(last < 0.5 * first, "feasible: mean r_post {last:e} vs first pass {first:e}");
+    // (b) infeasible: collisions win; the residual is not made worse.
+    let (first, last, ran) = run(-0.05, false, true);
+    assert!(ran > 0 && first > 1e-3, "the floor must conflict with the guide (r {first:e})");
+    assert!(last <= 1.01 * first, "infeasible: mean r_post {last:e} vs first pass {first:e}");
+}
