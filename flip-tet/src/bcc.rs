@@ -277,6 +277,21 @@ impl TetMesh {
         self.tets.len()
     }
 
+    /// Whether tet `t` of a mesh built by [`tetrahedralize`] from an octree with resolution `spec`
+    /// is a *transition tet* (spec §3.2 table): its two cube-centre vertices (local 0 = `c_B` and
+    /// 1 = the apex, the order in which the construction emits them) come from cubes of different
+    /// levels, i.e. the apex is neither a boundary face centre nor the centre of an equal cube at
+    /// distance `h` of the tet's level. Only these tets can have obtuse dihedral angles and
+    /// positive stiffness couplings (T-MESH-GRADED). Used by the mesh tests and the hard cases of
+    /// spec §8 (H-GRADED-IFACE, H-SHARP-GRADING). Meaningless for hand-made meshes.
+    pub fn is_transition(&self, t: usize, spec: &crate::octree::OctreeSpec) -> bool {
+        let (c, a) = (self.tets[t][0] as usize, self.tets[t][1] as usize);
+        let (k0, k1) = (self.node_key[c].0, self.node_key[a].0);
+        let d2: i64 = (0..3).map(|i| i64::from(k0[i] - k1[i]).pow(2)).sum();
+        let h2 = i64::from(spec.size_units(self.tet_level[t])).pow(2);
+        self.node_boundary[a] == 0 && d2 != h2 && d2 * 4 != h2
+    }
+
     /// Computes volumes, barycentric gradients, centroids (parallel), face neighbours and
     /// node → tet lists from `nodes` and `tets`. `h_ref` scales the degeneracy test: a tet with
     /// `V ≤ 1e−14 h_ref³` (or negative) is [`MeshError::DegenerateTet`].

@@ -104,6 +104,9 @@ pub struct StepStats {
     pub n_ghost_tets: usize,
     /// Interface tets with `k_t < 1`.
     pub n_k_reduced: usize,
+    /// Tets whose weakly covered P2G velocity was blended with the extrapolated one (spec §3.7,
+    /// §8 H-COARSE-LANDING).
+    pub n_weak_blend: usize,
     /// Solver report.
     pub solver: SolveReport,
     /// `Σ (2r)³` (m³).
@@ -757,8 +760,10 @@ impl FlipTetSim {
         let layers = self.scene.transfer.extrapolation_layers.unwrap_or(self.scene.flip.cfl.ceil() as u32 + 2);
         let mut u_old = p2g.u.clone();
         let mut valid = p2g.valid.clone();
+        // Weak coverage first (its `u_ext` is one extrapolation pass from the well-covered tets),
+        // so that the extrapolation below spreads the blended values (spec §3.7).
+        st.n_weak_blend = blend_weak(&self.mesh, &p2g, &mut u_old, &self.scene.transfer);
         extrapolate(&self.mesh, &mut u_old, &mut valid, layers);
-        blend_weak(&p2g, &mut u_old, &self.scene.transfer);
         // Tets below the coverage threshold that nothing reached by extrapolation keep their own
         // (weak) particle average instead of zero: a droplet cluster smaller than a cube has no
         // valid tet at all and would otherwise lose its momentum every step (spec §8 H-DROPLET-8).

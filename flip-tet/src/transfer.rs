@@ -95,15 +95,45 @@ pub fn particles_to_tets(mesh: &TetMesh, h_tet: &[f64], parts: &Particles, p: &T
     }
 }
 
-/// Weak-coverage blend after the first extrapolation (spec §3.7): for valid tets with coverage
-/// below `omega_blend`, `u ← (Ω u_p2g + (ω_blend − Ω) u_ext) / ω_blend` (coverages in `v_ref`).
-pub fn blend_weak(p2g: &TetVelocity, extrapolated: &mut [Vec3], p: &TransferParams) {
-    for (t, e) in extrapolated.iter_mut().enumerate() {
-        let cov = p2g.coverage[t];
-        if p2g.valid[t] && cov < p.omega_blend {
-            *e = (p2g.u[t] * cov + *e * (p.omega_blend - cov)) / p.omega_blend;
+/// Weak-coverage blend (spec §3.7): every valid tet with coverage `Ω < ω_blend` (in units of
+/// `v_ref`) takes `u ← (Ω u_p2g + (ω_blend − Ω) u_ext) / ω_blend`, where `u_ext` is the value one
+/// extrapolation pass gives it from the *well-covered* tets (`Ω ≥ ω_blend`): the mean over its
+/// nodes of their volume-weighted averages of well-covered incident tets. A weak tet with no
+/// well-covered tet around any of its nodes keeps its P2G value. Writes into `u` (which holds the
+/// P2G values on entry) and returns the number of blended tets.
+///
+/// Why `u_ext` must exclude the weak tets themselves: the extrapolation leaves valid tets
+/// unchanged, so blending with the extrapolated field of the ordinary mask (the first version of
+/// this function) blended each weak tet with its own value, a no-op, and a few small particles
+/// in a coarse tet kept imposing their velocity on it (the momentum artefact of spec §8
+/// H-COARSE-LANDING).
+pub fn blend_weak(mesh: &TetMesh, p2g: &TetVelocity, u: &mut [Vec3], p: &TransferParams) -> usize {
+    let weak = |t: usize| p2g.valid[t] && p2g.coverage[t] < p.omega_blend;
+    if !(0..u.len()).any(weak) {
+        return 0;
+    }
+    let strong: Vec<bool> = (0..u.len()).map(|t| p2g.valid[t] && !weak(t)).collect();
+    let nv = node_values(mesh, &p2g.u, &strong, 0);
+    let mut n = 0;
+    for (t, e) in u.iter_mut().enumerate() {
+        if !weak(t) {
+            continue;
+        }
+        let (mut s, mut c) = (Vec3::zeros(), 0usize);
+        for &i in &mesh.tets[t] {
+            if let Some(v) = nv[i as usize] {
+                s += v;
+                c += 1;
+            }
+        }
+        if c > 0 {
+            let ext = s / c as f64;
+            let cov = p2g.coverage[t];
+            *e = (p2g.u[t] * cov + ext * (p.omega_blend - cov)) / p.omega_blend;
+            n += 1;
         }
     }
+    n
 }
 
 /// Volume-weighted average at node `i` of `f(t)` over its incident tets where `f` gives a value;
@@ -265,6 +295,33 @@ mod tests {
         let x = Pt3::new(0.33, 0.71, 0.12);
         let (t, l) = m.locate(&oct, &x).unwrap();
         assert!((sample(&m, &uc, &nc, t, &l) - c).norm() < 1e-14);
+    }
+
+    /// Weak-coverage blend: a weakly covered tet next to well-covered ones moves towards their
+    /// velocity by the fraction `(ω_blend − Ω)/ω_blend`; well-covered tets are unchanged; with a
+    /// single velocity everywhere the blend is exact (constants are reproduced).
+    #[test]
+    fn weak_blend_moves_weak_tets_towards_well_covered_neighbours() {
+        let (_, m) = mesh();
+        let n = m.tets.len();
+        let p = TransferParams::default();
+        let (a, b) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(0.0, -2.0, 0.0));
+        // Tet 0 is weak (Ω = 0.2) with velocity b; every other tet is well covered with a.
+        let p2g = TetVelocity {
+            u: (0..n).map(|t| if t == 0 { b } else { a }).collect(),
+            valid: vec![true; n],
+            coverage: (0..n).map(|t| if t == 0 { 0.2 } else { 1.0 }).collect(),
+        };
+        let mut u = p2g.u.clone();
+        assert_eq!(blend_weak(&m, &p2g, &mut u, &p), 1);
+        let want = (b * 0.2 + a * 0.3) / 0.5;
+        assert!((u[0] - want).norm() < 1e-14, "{:?} vs {want:?}", u[0]);
+        assert!(u[1..].iter().all(|v| *v == a));
+        // Constant field: the blend returns the constant.
+        let pc = TetVelocity { u: vec![a; n], ..p2g.clone() };
+        let mut uc = pc.u.clone();
+        blend_weak(&m, &pc, &mut uc, &p);
+        assert!(uc.iter().all(|v| (v - a).norm() < 1e-15));
     }
 
     /// T-P2G-CONST and T-EXTRAP: constant particle velocity gives the constant in every valid

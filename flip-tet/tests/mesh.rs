@@ -107,10 +107,7 @@ fn t_mesh_graded_dihedrals_and_positive_couplings() {
                 assert!((30.0 - 1e-6..=135.0 + 1e-6).contains(&d), "dihedral {d}");
             }
             // Transition tets: the two "centre" vertices come from cubes of different levels.
-            let (k0, k1) = (mesh.node_key[mesh.tets[t][0] as usize].0, mesh.node_key[mesh.tets[t][1] as usize].0);
-            let d2: i64 = (0..3).map(|a| i64::from(k0[a] - k1[a]).pow(2)).sum();
-            let h2 = i64::from(oct.spec.size_units(mesh.tet_level[t])).pow(2);
-            let transition = mesh.node_boundary[mesh.tets[t][1] as usize] == 0 && d2 != h2 && d2 * 4 != h2;
+            let transition = mesh.is_transition(t, &oct.spec);
             let v = mesh.volume[t];
             let kii = v * g[0].norm_squared();
             let positive =
