@@ -16,82 +16,16 @@
 //! scene's cloth (gravity, ground contact off: the solve does not depend on collisions).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use geom_core::linalg::Csc;
-use geom_core::math::{Pt3, Vec3};
+use geom_core::math::Vec3;
 use geom_core::mesh::subdivide_linear;
-use shells::{DofMap, Effects, ImplicitSystem, IntegratorSettings, ShellSceneDesc, ShellSim, VelocitySolve};
+use shells::VelocitySolve;
 use std::hint::black_box;
 use tracks::metrics::LowPass;
-use tracks::procedural::{bag_guide, xavier, xavier_guide, xavier_material, Xavier};
+use tracks::procedural::{bag_guide, xavier, xavier_guide, xavier_sim, Xavier};
 use tracks::{
-    build_test_functions, cluster, pg_mass_matrix, ClusterOptions, GuideAnimation, KktMethod, TestFunctionSpec,
-    TestFunctions, TrackOptions, TrackingConstraints, TrackingSolver,
+    build_test_functions, cluster, pg_mass_matrix, CapturedSystem, ClusterOptions, GuideAnimation, KktMethod,
+    TestFunctionSpec, TestFunctions, TrackOptions, TrackingConstraints, TrackingSolver,
 };
-
-fn xavier_sim(x: &Xavier, guide: &GuideAnimation) -> ShellSim {
-    let mut g0 = vec![Pt3::origin(); guide.n_vertices()];
-    guide.sample(0.0, &mut g0);
-    ShellSim::new(ShellSceneDesc {
-        rest: x.mesh.positions.clone(),
-        faces: x.mesh.faces.clone(),
-        uv: None,
-        initial: Some(g0),
-        initial_velocity: None,
-        material: xavier_material(),
-        effects: Effects { gravity: Some(Vec3::new(0.0, -9.81, 0.0)), ..Effects::default() },
-        constraints: vec![],
-        integrator: IntegratorSettings::default(),
-        t0: 0.0,
-    })
-    .expect("the Xavier cloth is a valid shell scene")
-}
-
-/// An owned copy of one step's implicit system (the solver interface borrows it).
-struct Captured {
-    a: Csc,
-    b: Vec<f64>,
-    q_pred: Vec<Pt3>,
-    v0: Vec<Vec3>,
-    h_eff: f64,
-    dofs: DofMap,
-    h: f64,
-    t_next: f64,
-}
-
-impl Captured {
-    fn system(&self) -> ImplicitSystem<'_> {
-        ImplicitSystem {
-            a: &self.a,
-            b: &self.b,
-            q_pred: &self.q_pred,
-            v0: &self.v0,
-            h_eff: self.h_eff,
-            dofs: &self.dofs,
-            h: self.h,
-            t_next: self.t_next,
-        }
-    }
-}
-
-/// Records the system and answers with the untracked LLᵀ solve (the sim's own default).
-struct Capture(Option<Captured>);
-
-impl VelocitySolve for Capture {
-    fn solve(&mut self, sys: &ImplicitSystem) -> shells::Result<Vec<f64>> {
-        self.0 = Some(Captured {
-            a: sys.a.clone(),
-            b: sys.b.to_vec(),
-            q_pred: sys.q_pred.to_vec(),
-            v0: sys.v0.to_vec(),
-            h_eff: sys.h_eff,
-            dofs: sys.dofs.clone(),
-            h: sys.h,
-            t_next: sys.t_next,
-        });
-        // Δv = 0 is a valid (if unphysical) answer: only the captured system is used.
-        Ok(vec![0.0; sys.b.len()])
-    }
-}
 
 /// Xavier's test functions with `k` animation-aware clusters (μ = 0.98, F = 32, seed 7).
 fn clusters(guide: &GuideAnimation, x: &Xavier, k: usize) -> TestFunctions {
@@ -122,11 +56,9 @@ fn constraints_build(c: &mut Criterion) {
 fn kkt_factor(c: &mut Criterion) {
     let x = xavier().expect("xavier");
     let guide = xavier_guide(&x, 2.0).expect("xavier guide");
-    let mut sim = xavier_sim(&x, &guide);
+    let mut sim = xavier_sim(&x, &guide).expect("the Xavier cloth is a valid shell scene");
     sim.step(1.0 / 120.0).expect("first step");
-    let mut cap = Capture(None);
-    sim.step_with(1.0 / 120.0, &mut cap).expect("captured step");
-    let sys = cap.0.expect("the step called the solver");
+    let sys = CapturedSystem::capture_step(&mut sim, 1.0 / 120.0).expect("captured step");
     let mut g = c.benchmark_group("kkt_factor");
     g.sample_size(20);
     {

@@ -8,39 +8,11 @@
 //! `cargo run --release -p tracks --example kkt_orderings -- [K = 280] [δ = 1e-8]`
 use faer::sparse::{SparseColMat, SymbolicSparseColMat};
 use geom_core::linalg::{Csc, Ordering, Regularization, SparseLdlt, SparseLlt};
-use geom_core::math::{Pt3, Vec3};
 use geom_core::NONE;
-use shells::{DofMap, Effects, ImplicitSystem, IntegratorSettings, ShellSceneDesc, ShellSim, VelocitySolve};
+use shells::VelocitySolve;
 use std::time::Instant;
-use tracks::procedural::{xavier, xavier_guide, xavier_material};
-use tracks::{build_test_functions, ClusterOptions, TestFunctionSpec, TrackingConstraints};
-
-struct Captured {
-    a: Csc,
-    b: Vec<f64>,
-    dofs: DofMap,
-    q_pred: Vec<Pt3>,
-    v0: Vec<Vec3>,
-    h_eff: f64,
-    h: f64,
-    t_next: f64,
-}
-struct Capture(Option<Captured>);
-impl VelocitySolve for Capture {
-    fn solve(&mut self, sys: &ImplicitSystem) -> shells::Result<Vec<f64>> {
-        self.0 = Some(Captured {
-            a: sys.a.clone(),
-            b: sys.b.to_vec(),
-            dofs: sys.dofs.clone(),
-            q_pred: sys.q_pred.to_vec(),
-            v0: sys.v0.to_vec(),
-            h_eff: sys.h_eff,
-            h: sys.h,
-            t_next: sys.t_next,
-        });
-        Ok(vec![0.0; sys.b.len()])
-    }
-}
+use tracks::procedural::{xavier, xavier_guide, xavier_sim};
+use tracks::{build_test_functions, CapturedSystem, ClusterOptions, TestFunctionSpec, TrackingConstraints};
 
 fn time<F: FnMut()>(mut f: F) -> f64 {
     let mut best = f64::INFINITY;
@@ -57,39 +29,14 @@ fn main() {
     let delta_rel: f64 = std::env::args().nth(2).and_then(|s| s.parse().ok()).unwrap_or(1e-8);
     let x = xavier().expect("xavier");
     let guide = xavier_guide(&x, 2.0).expect("guide");
-    let mut g0 = vec![Pt3::origin(); guide.n_vertices()];
-    guide.sample(0.0, &mut g0);
-    let mut sim = ShellSim::new(ShellSceneDesc {
-        rest: x.mesh.positions.clone(),
-        faces: x.mesh.faces.clone(),
-        uv: None,
-        initial: Some(g0),
-        initial_velocity: None,
-        material: xavier_material(),
-        effects: Effects { gravity: Some(Vec3::new(0.0, -9.81, 0.0)), ..Effects::default() },
-        constraints: vec![],
-        integrator: IntegratorSettings::default(),
-        t0: 0.0,
-    })
-    .expect("sim");
+    let mut sim = xavier_sim(&x, &guide).expect("the Xavier cloth is a valid shell scene");
     sim.step(1.0 / 120.0).expect("step");
-    let mut cap = Capture(None);
-    sim.step_with(1.0 / 120.0, &mut cap).expect("step");
-    let sys = cap.0.expect("captured");
+    let sys = CapturedSystem::capture_step(&mut sim, 1.0 / 120.0).expect("captured step");
     let opts = ClusterOptions { regions: k, mu: 0.98, frames: 32, seed: 7, ..ClusterOptions::default() };
     let tf = build_test_functions(&TestFunctionSpec::Clustered(opts), &guide, &x.mesh, None).expect("tf");
     let cons = TrackingConstraints::build(&x.mesh, &x.mesh, &tf).expect("cons");
     {
-        let isys = ImplicitSystem {
-            a: &sys.a,
-            b: &sys.b,
-            q_pred: &sys.q_pred,
-            v0: &sys.v0,
-            h_eff: sys.h_eff,
-            dofs: &sys.dofs,
-            h: sys.h,
-            t_next: sys.t_next,
-        };
+        let isys = sys.system();
         for refine in [0u32, 1] {
             let opts = tracks::TrackOptions {
                 kkt: tracks::KktMethod::AmdRegularizedLdlt { delta: 1e-8 },

@@ -10,12 +10,14 @@
 //! Modules: [`guide`] (guide trajectories), [`testfn`] and [`cluster`] (test-function designs),
 //! [`constraints`] (𝓜, C̄, C, eq. 8, rank), [`kkt`] (the saddle-point solvers) and [`augmented`] (the augmented-Lagrangian one), [`tracker`] (the
 //! constrained step, initial projection, residuals), [`metrics`] (deviation, wavelength, tug
-//! index, …) and [`procedural`] (the guides of the paper's scenes).
+//! index, …), [`procedural`] (the guides of the paper's scenes) and [`capture`] (one step's
+//! system kept for benchmarks).
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![allow(clippy::needless_range_loop)]
 
 pub mod augmented;
+pub mod capture;
 pub mod cluster;
 pub mod constraints;
 pub mod error;
@@ -26,6 +28,7 @@ pub mod procedural;
 pub mod testfn;
 pub mod tracker;
 
+pub use capture::CapturedSystem;
 pub use cluster::{cluster, ClusterInit, ClusterMetric, ClusterOptions, Clustering};
 pub use constraints::{pg_mass_matrix, GramFactor, TrackingConstraints};
 pub use error::{Result, TrackError};

@@ -218,6 +218,26 @@ pub fn xavier_material() -> shells::Material {
     }
 }
 
+/// Xavier's cloth as a plain `shells` simulation in [`xavier_material`] with gravity only (no
+/// contact, no wind), starting on the guide's first frame: the untracked system of the solver
+/// benchmarks (`benches/tracking.rs`, `examples/kkt_orderings.rs`).
+pub fn xavier_sim(x: &Xavier, guide: &GuideAnimation) -> shells::Result<shells::ShellSim> {
+    let mut g0 = vec![Pt3::origin(); guide.n_vertices()];
+    guide.sample(0.0, &mut g0);
+    shells::ShellSim::new(shells::ShellSceneDesc {
+        rest: x.mesh.positions.clone(),
+        faces: x.mesh.faces.clone(),
+        uv: None,
+        initial: Some(g0),
+        initial_velocity: None,
+        material: xavier_material(),
+        effects: shells::Effects { gravity: Some(Vec3::new(0.0, -9.81, 0.0)), ..shells::Effects::default() },
+        constraints: vec![],
+        integrator: shells::IntegratorSettings::default(),
+        t0: 0.0,
+    })
+}
+
 /// Builds the Xavier mesh and its rig data (spec §6.4): box surface 31 × 36 × 6 segments mapped
 /// to an X by ρ = max(|u|,|w|), φ = atan2(w, u), R(φ) = 0.50 + 0.77 sin²(2φ), then 10 Taubin
 /// passes (λ = 0.5, μ = −0.53).

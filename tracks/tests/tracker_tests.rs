@@ -15,9 +15,14 @@ fn coarse() -> TriMesh {
 }
 
 fn sim_of(m: &TriMesh, gravity: bool, alpha: f64, pins: Vec<u32>, v0: Vec3) -> ShellSim {
+    let effects = Effects { gravity: gravity.then(|| Vec3::new(0.0, -9.81, 0.0)), ..Effects::default() };
+    sim_with(m, effects, alpha, pins, v0)
+}
+
+/// Cotton with Rayleigh damping (α, β = 1e-4) on mesh `m` with the given effects.
+fn sim_with(m: &TriMesh, effects: Effects, alpha: f64, pins: Vec<u32>, v0: Vec3) -> ShellSim {
     let mut mat = Material::cotton();
     mat.damping = Damping::Rayleigh { alpha, beta: 1e-4 };
-    let effects = Effects { gravity: gravity.then(|| Vec3::new(0.0, -9.81, 0.0)), ..Effects::default() };
     ShellSim::new(ShellSceneDesc {
         rest: m.positions.clone(),
         faces: m.faces.clone(),
@@ -47,13 +52,22 @@ fn waving_guide(c: &TriMesh) -> GuideAnimation {
 }
 
 fn tracker(method: KktMethod, levels: u32) -> (Tracker, f64) {
+    tracker_with(TrackOptions { kkt: method, ..TrackOptions::default() }, levels, gravity_only())
+}
+
+fn gravity_only() -> Effects {
+    Effects { gravity: Some(Vec3::new(0.0, -9.81, 0.0)), ..Effects::default() }
+}
+
+/// The waving coarse grid tracked by its `levels`-times subdivided copy (subdivision hats, at
+/// rest, no damping but β = 1e-4) with `effects` and `opts`; returns it and the guide scale L.
+fn tracker_with(opts: TrackOptions, levels: u32, effects: Effects) -> (Tracker, f64) {
     let c = coarse();
     let (fine, p) = subdivide_linear(&c, levels);
     let g = waving_guide(&c);
     let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
-    let sim = sim_of(&fine, true, 0.0, vec![], Vec3::zeros());
+    let sim = sim_with(&fine, effects, 0.0, vec![], Vec3::zeros());
     let l = g.scale();
-    let opts = TrackOptions { kkt: method, ..TrackOptions::default() };
     (Tracker::new(sim, g, tf, Some(p), opts).expect("tracker"), l)
 }
 
@@ -322,14 +336,9 @@ fn physical_guide_is_free() {
 /// timed, and agrees with it (1e-9 relative on Δv; the factorisations differ in rounding only).
 #[test]
 fn compare_methods_on_identical_systems() {
-    let c = coarse();
-    let (fine, p) = subdivide_linear(&c, 2);
-    let g = waving_guide(&c);
-    let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
-    let sim = sim_of(&fine, true, 0.0, vec![], Vec3::zeros());
     let compare = vec![KktMethod::InterleavedLdlt, KktMethod::Schur, KktMethod::AmdRegularizedLdlt { delta: 1e-8 }];
     let opts = TrackOptions { compare: compare.clone(), ..TrackOptions::default() };
-    let mut tr = Tracker::new(sim, g, tf, Some(p), opts).expect("tracker");
+    let (mut tr, _) = tracker_with(opts, 2, gravity_only());
     for _ in 0..3 {
         let s = tr.step(1.0 / 60.0).expect("step");
         assert_eq!(s.compare.len(), compare.len());
@@ -348,14 +357,8 @@ fn compare_methods_on_identical_systems() {
 #[test]
 fn unrefined_shift_is_warm_started() {
     let run = |m: KktMethod| {
-        let c = coarse();
-        let (fine, p) = subdivide_linear(&c, 2);
-        let g = waving_guide(&c);
-        let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
-        let sim = sim_of(&fine, true, 0.0, vec![], Vec3::zeros());
-        let l = g.scale();
         let opts = TrackOptions { kkt: m, refine_steps: 0, ..TrackOptions::default() };
-        let mut tr = Tracker::new(sim, g, tf, Some(p), opts).expect("tracker");
+        let (mut tr, l) = tracker_with(opts, 2, gravity_only());
         let r: Vec<f64> = (0..20).map(|_| tr.step(1.0 / 120.0).expect("step").residual_pre_collision).collect();
         (r, tr.sim.state().v.clone(), l)
     };
@@ -376,15 +379,9 @@ fn unrefined_shift_is_warm_started() {
 /// refinement step by itself; r_pre stays ≤ 1e-10·L at every step.
 #[test]
 fn shift_residual_test_adds_refinement() {
-    let c = coarse();
-    let (fine, p) = subdivide_linear(&c, 2);
-    let g = waving_guide(&c);
-    let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
-    let sim = sim_of(&fine, true, 0.0, vec![], Vec3::zeros());
-    let l = g.scale();
     let opts =
         TrackOptions { kkt: KktMethod::AmdRegularizedLdlt { delta: 1e-6 }, refine_steps: 0, ..TrackOptions::default() };
-    let mut tr = Tracker::new(sim, g, tf, Some(p), opts).expect("tracker");
+    let (mut tr, l) = tracker_with(opts, 2, gravity_only());
     let mut refined = 0;
     for _ in 0..20 {
         let s = tr.step(1.0 / 120.0).expect("step");
@@ -407,12 +404,6 @@ fn shift_residual_test_adds_refinement() {
 fn reprojection_after_collisions() {
     use shells::{CollisionSettings, Obstacle, ObstacleShape};
     let run = |floor: f64, project: bool, reproject: bool| {
-        let c = coarse();
-        let (fine, p) = subdivide_linear(&c, 2);
-        let g = waving_guide(&c);
-        let tf = build_test_functions(&TestFunctionSpec::SubdivisionBasis, &g, &fine, Some(&p)).expect("tf");
-        let mut mat = Material::cotton();
-        mat.damping = Damping::Rayleigh { alpha: 0.0, beta: 1e-4 };
         let plane =
             Obstacle { shape: ObstacleShape::Plane { normal: Vec3::y(), offset: floor }, friction: 0.5, motion: None };
         let effects = Effects {
@@ -421,25 +412,12 @@ fn reprojection_after_collisions() {
             collision: Some(CollisionSettings::default()),
             ..Effects::default()
         };
-        let sim = ShellSim::new(ShellSceneDesc {
-            rest: fine.positions.clone(),
-            faces: fine.faces.clone(),
-            uv: None,
-            initial: None,
-            initial_velocity: None,
-            material: mat,
-            effects,
-            constraints: vec![],
-            integrator: IntegratorSettings::default(),
-            t0: 0.0,
-        })
-        .expect("valid sim");
         let opts = TrackOptions {
             reproject_after_collisions: reproject,
             project_initial_state: project,
             ..TrackOptions::default()
         };
-        let mut tr = Tracker::new(sim, g, tf, Some(p), opts).expect("tracker");
+        let (mut tr, _) = tracker_with(opts, 2, effects);
         let (mut first, mut last, mut ran) = (0.0, 0.0, 0);
         for _ in 0..120 {
             let s = tr.step(1.0 / 120.0).expect("step");
