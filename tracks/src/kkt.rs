@@ -31,6 +31,10 @@ use crate::guide::GuideAnimation;
 /// 10× below the spec's r_pre ≤ 1e-9·L, so the shift never decides that target.
 pub const SHIFT_RESIDUAL_TOL: f64 = 1e-10;
 
+/// Most refinement steps [`KktMethod::AmdRegularizedLdlt`] takes to reach
+/// [`SHIFT_RESIDUAL_TOL`] (the spec's "2–3 refinement steps"); `refine_steps` above it wins.
+pub const MAX_SHIFT_REFINE_STEPS: u32 = 3;
+
 /// Saddle-point solver (spec §3.6).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Deserialize, serde::Serialize)]
 pub enum KktMethod {
@@ -107,8 +111,9 @@ pub struct KktStats {
     pub guide_held: bool,
     /// Stored entries of the factor (LDLᵀ or LLᵀ).
     pub nnz_l: usize,
-    /// Refinement steps the last solve took (AmdRegularizedLdlt adds one when the warm-started
-    /// shifted solve leaves a constraint residual above `SHIFT_RESIDUAL_TOL`·L).
+    /// Refinement steps the last solve took (AmdRegularizedLdlt adds steps, up to
+    /// `MAX_SHIFT_REFINE_STEPS`, while its solve leaves a constraint residual above
+    /// `SHIFT_RESIDUAL_TOL`·L).
     pub refine_steps_done: u32,
     /// Per method of `TrackOptions::compare`: wall time of its solve of the same system (s),
     /// max |Δv − Δv_main| / max |Δv_main|, and its factor's stored entries.
@@ -430,34 +435,34 @@ impl TrackingSolver {
                 // Warm-started shift (one proximal-point iteration of the method of
                 // multipliers per step): the shifted rows read ĈΔv − δμ = r − δμ_prev, so the
                 // shift's error is δ(μ − μ_prev) instead of δμ, at no cost. Then `refine_steps`
-                // rounds of refinement against the exact KKT, at least one whenever the
-                // constraint rows still miss r by more than `SHIFT_RESIDUAL_TOL`·L in position
-                // (h_eff·‖(ĈΔv − r)_i‖, the residual_pre this solve would leave).
+                // rounds of refinement against the exact KKT, and more (up to
+                // `MAX_SHIFT_REFINE_STEPS`) while the constraint rows still miss r by more than
+                // `SHIFT_RESIDUAL_TOL`·L in position (h_eff·‖(ĈΔv − r)_i‖, the residual_pre
+                // this solve would leave).
                 x.copy_from_slice(&rhs);
                 if self.mu_prev.len() == m {
                     x[n..].iter_mut().zip(&self.mu_prev).for_each(|(xi, mp)| *xi -= shift * mp);
                 }
-                let steps = match ldlt.solve_in_place(&mut x) {
-                    Ok(()) => {
-                        let mut cx = vec![0.0; m];
-                        c_mul(self.cft.as_ref().expect("built before use"), &x[..n], &mut cx);
-                        let miss = cx
-                            .chunks(3)
-                            .zip(r.chunks(3))
-                            .map(|(a, b)| {
-                                ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
-                            })
-                            .fold(0.0f64, f64::max);
-                        if sys.h_eff * miss > SHIFT_RESIDUAL_TOL * self.guide_scale {
-                            refine.max(1)
-                        } else {
-                            refine
-                        }
-                    }
-                    Err(_) => refine,
+                let cft = self.cft.as_ref().expect("built before use");
+                let tol = SHIFT_RESIDUAL_TOL * self.guide_scale / sys.h_eff.max(1e-300);
+                let mut cx = vec![0.0; m];
+                let mut misses = |x: &[f64]| {
+                    c_mul(cft, &x[..n], &mut cx);
+                    cx.chunks(3).zip(r.chunks(3)).any(|(a, b)| {
+                        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt() > tol
+                    })
                 };
-                self.last.refine_steps_done = steps;
-                ldlt.refine(&kkt.exact, &rhs, &mut x, steps)
+                let max_steps = refine.max(MAX_SHIFT_REFINE_STEPS);
+                let mut done = 0;
+                let solved = ldlt.solve_in_place(&mut x).and_then(|()| {
+                    while done < refine || (done < max_steps && misses(&x)) {
+                        ldlt.refine(&kkt.exact, &rhs, &mut x, 1)?;
+                        done += 1;
+                    }
+                    ldlt.refine(&kkt.exact, &rhs, &mut x, 0)
+                });
+                self.last.refine_steps_done = done;
+                solved
             }
             _ => ldlt.solve_refined(&kkt.exact, &rhs, &mut x, refine),
         }

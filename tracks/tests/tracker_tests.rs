@@ -375,8 +375,8 @@ fn unrefined_shift_is_warm_started() {
 }
 
 /// AmdRegularizedLdlt with a coarse shift (δ = 1e-6) and `refine_steps: 0`: the warm-started
-/// solve misses the constraints by more than `SHIFT_RESIDUAL_TOL`·L, so the solver adds a
-/// refinement step by itself; r_pre stays ≤ 1e-10·L at every step.
+/// solve misses the constraints by more than `SHIFT_RESIDUAL_TOL`·L, so the solver adds
+/// refinement steps by itself (up to `MAX_SHIFT_REFINE_STEPS`); r_pre stays ≤ 1e-10·L.
 #[test]
 fn shift_residual_test_adds_refinement() {
     let opts =

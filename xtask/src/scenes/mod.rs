@@ -9,3 +9,4 @@ pub mod motion_graph;
 pub mod rigging;
 pub mod shells;
 pub mod tracks;
+pub mod tracks_variants;

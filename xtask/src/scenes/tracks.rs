@@ -422,19 +422,19 @@ pub(crate) fn frames_for(duration: f64, fps: f64) -> usize {
 
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct PairParams {
+pub(crate) struct PairParams {
     /// Simulated time (s) for quick / default / full.
-    duration: (f64, f64, f64),
+    pub duration: (f64, f64, f64),
     /// Substeps per frame for quick / default / full.
-    substeps: (u32, u32, u32),
+    pub substeps: (u32, u32, u32),
     /// Self-collision for quick / default / full.
-    self_collision: (bool, bool, bool),
+    pub self_collision: (bool, bool, bool),
     /// Saddle-point solver.
-    kkt: KktMethod,
+    pub kkt: KktMethod,
     /// Iterative refinement steps after the LDLᵀ solve.
-    refine_steps: u32,
+    pub refine_steps: u32,
     /// Write OBJ frames every n frames (0 = never).
-    obj_every: usize,
+    pub obj_every: usize,
 }
 
 pub(crate) fn track_opts(kkt: KktMethod, refine_steps: u32) -> TrackOptions {
