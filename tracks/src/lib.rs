@@ -10,8 +10,8 @@
 //! Modules: [`guide`] (guide trajectories), [`testfn`] and [`cluster`] (test-function designs),
 //! [`constraints`] (𝓜, C̄, C, eq. 8, rank), [`kkt`] (the saddle-point solvers) and [`augmented`] (the augmented-Lagrangian one), [`tracker`] (the
 //! constrained step, initial projection, residuals), [`metrics`] (deviation, wavelength, tug
-//! index, …), [`procedural`] (the guides of the paper's scenes) and [`capture`] (one step's
-//! system kept for benchmarks).
+//! index, …), [`procedural`] (the guides of the paper's scenes), [`rest_events`] (scheduled rest-angle
+//! changes) and [`capture`] (one step's system kept for benchmarks).
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![allow(clippy::needless_range_loop)]
@@ -25,6 +25,7 @@ pub mod guide;
 pub mod kkt;
 pub mod metrics;
 pub mod procedural;
+pub mod rest_events;
 pub mod testfn;
 pub mod tracker;
 
@@ -34,5 +35,6 @@ pub use constraints::{pg_mass_matrix, GramFactor, TrackingConstraints};
 pub use error::{Result, TrackError};
 pub use guide::{GuideAnimation, ProceduralFn, TimeInterp};
 pub use kkt::{CompareStats, KktMethod, KktStats, TrackingSolver};
+pub use rest_events::RestEvents;
 pub use testfn::{build_test_functions, RegionSel, TestFunctionSpec, TestFunctions, TestKind};
 pub use tracker::{TrackOptions, TrackStepStats, Tracker};

@@ -134,6 +134,9 @@ pub(crate) struct Setup {
     pub tf: TestFunctions,
     pub fps: f64,
     pub substeps: u32,
+    /// Scheduled rest-angle changes applied to the tracked and the untracked run alike
+    /// (Xavier's CrinkleRest / RestoreRest, spec §6.4); `None` for the other scenes.
+    pub rest_events: Option<std::sync::Arc<tracks::RestEvents>>,
 }
 
 /// What to run and record.
@@ -177,6 +180,8 @@ pub(crate) struct PairOut {
     pub final_tracked: Vec<Pt3>,
     pub final_untracked: Vec<Pt3>,
     pub ke_tracked: Vec<f64>,
+    /// Times the rest-angle events changed the tracked run's rest angles.
+    pub rest_updates: usize,
     /// Detail wavelength λ_eff = 2π sqrt(hᵀM_L h / hᵀK h) of h = d − L_τ d per frame ≥ 1 (spec §3.8).
     pub lambda_eff_tracked: Vec<f64>,
     pub step_times: Vec<(f64, f64)>,
@@ -288,9 +293,21 @@ pub(crate) fn run_pair(setup: &Setup, o: &PairOpts, out_dir: &Path) -> Result<Pa
         &out_dir.join(format!("frames{tag}.csv")),
         &["frame", "t", "dc_tracked", "dc_untracked", "a_d", "rms_d", "bend_J", "tug", "isect_tracked", "isect_guide"],
     )?;
+    // Weight of the rest-angle events last applied (`Setup::rest_events`).
+    let mut rest_w = 0.0;
     for frame in 0..=o.frames {
         if frame > 0 {
             for _ in 0..setup.substeps {
+                if let Some(ev) = setup.rest_events.as_ref() {
+                    // The rest angles of the step's end time, on both runs alike (not timed).
+                    let t_next = tr.sim.state().t + h;
+                    let mut w = rest_w;
+                    out.rest_updates += usize::from(sh(ev.apply(&mut tr.sim, t_next, &mut w))?);
+                    if let Some(u) = un.as_mut() {
+                        sh(ev.apply(u, t_next, &mut rest_w))?;
+                    }
+                    rest_w = w;
+                }
                 let st = tk(tr.step(h))?;
                 out.t_tracked += st.t_step;
                 out.t_kkt += st.t_kkt;
@@ -591,6 +608,7 @@ pub(crate) fn flag_setup(d: &FlagDesign, substeps: u32, self_collision: bool) ->
         tf,
         fps: FLAG_FPS,
         substeps,
+        rest_events: None,
     })
 }
 
@@ -637,6 +655,7 @@ pub(crate) fn box_setup(substeps: u32, self_collision: bool) -> Result<Setup> {
         tf,
         fps: 30.0,
         substeps,
+        rest_events: None,
     })
 }
 
@@ -687,6 +706,7 @@ pub(crate) fn bag_setup(substeps: u32, self_collision: bool) -> Result<Setup> {
         tf,
         fps: 30.0,
         substeps,
+        rest_events: None,
     })
 }
 
@@ -736,17 +756,24 @@ pub(crate) fn xavier_setup(
         guide.sample(0.0, &mut p);
         p
     };
+    let desc = move || ShellSceneDesc {
+        initial: Some(g0.clone()),
+        ..shell_desc(&mesh, tracks::procedural::xavier_material(), xavier_effects(self_collision))
+    };
+    // CrinkleRest / RestoreRest (spec §6.4): ±4 mm normal noise, seed 7; they act from 7 s on,
+    // so only the full (10 s) run sees them.
+    // (An invalid description fails again, with its error, when `run_pair` builds the runs.)
+    let rest_events =
+        ShellSim::new(desc()).ok().map(|sim| std::sync::Arc::new(tracks::RestEvents::xavier(&sim, &x.mesh, 0.004, 7)));
     Setup {
         guide: guide.clone(),
         prolongation: None,
         tracked_rest: x.mesh.clone(),
-        desc: Box::new(move || ShellSceneDesc {
-            initial: Some(g0.clone()),
-            ..shell_desc(&mesh, tracks::procedural::xavier_material(), xavier_effects(self_collision))
-        }),
+        desc: Box::new(desc),
         tf,
         fps: 30.0,
         substeps,
+        rest_events,
     }
 }
 
@@ -767,7 +794,9 @@ fn run_xavier(ctx: &RunCtx) -> Result<Summary> {
     let (tf, clustering_s) = xavier_tf(&x, &guide)?;
     let k = tf.len();
     let setup = xavier_setup(&x, &guide, tf, pick3(m, p.substeps), pick3(m, p.self_collision));
-    let (_, mut s) = run_standard(ctx, &p, &setup, "xavier", false)?;
+    let (out, mut s) = run_standard(ctx, &p, &setup, "xavier", false)?;
+    // Rest-angle updates of the CrinkleRest / RestoreRest blends (0 before 7 s: quick and default).
+    s.set_count("rest_event_updates", out.rest_updates as u64);
     s.set("clustering_s", clustering_s);
     s.set_count("regions", k as u64);
     s.set("mesh_min_angle_deg", x.quality.0);
@@ -840,6 +869,7 @@ fn averaged_vs_pointwise(
             tf,
             fps: 30.0,
             substeps: pick3(m, p.substeps),
+            rest_events: None,
         }
     };
     let nb = avg_guide.n_vertices() as u32;

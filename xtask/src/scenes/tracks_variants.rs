@@ -112,7 +112,7 @@ const FPS: f64 = 30.0;
 
 /// Replaces the shell description of `s` by `edit` applied to it.
 fn edited(s: Setup, edit: Box<dyn Fn(&mut ShellSceneDesc)>) -> Setup {
-    let Setup { guide, prolongation, tracked_rest, desc, tf, fps, substeps } = s;
+    let Setup { guide, prolongation, tracked_rest, desc, tf, fps, substeps, rest_events } = s;
     Setup {
         desc: Box::new(move || {
             let mut d = desc();
@@ -125,6 +125,7 @@ fn edited(s: Setup, edit: Box<dyn Fn(&mut ShellSceneDesc)>) -> Setup {
         tf,
         fps,
         substeps,
+        rest_events,
     }
 }
 
