@@ -455,11 +455,14 @@ impl TrackingSolver {
                 let max_steps = refine.max(MAX_SHIFT_REFINE_STEPS);
                 let mut done = 0;
                 let solved = ldlt.solve_in_place(&mut x).and_then(|()| {
+                    // `refine` returns the residual after its step: only an unrefined solve
+                    // needs the extra residual evaluation.
+                    let mut res = None;
                     while done < refine || (done < max_steps && misses(&x)) {
-                        ldlt.refine(&kkt.exact, &rhs, &mut x, 1)?;
+                        res = Some(ldlt.refine(&kkt.exact, &rhs, &mut x, 1)?);
                         done += 1;
                     }
-                    ldlt.refine(&kkt.exact, &rhs, &mut x, 0)
+                    res.map_or_else(|| ldlt.refine(&kkt.exact, &rhs, &mut x, 0), Ok)
                 });
                 self.last.refine_steps_done = done;
                 solved

@@ -102,6 +102,9 @@ pub struct Tracker {
     /// Setup warnings (dropped rows, …).
     pub warnings: Vec<String>,
     gram: Option<GramFactor>,
+    /// Cᵀ of the enforced constraints (row l: the constraints touching vertex l), for the
+    /// mass-weighted corrections; `None` when K = 0.
+    ct: Option<Csr>,
     /// Inverse masses of free vertices, 0 for pinned/kinematic ones (the W of §3.5).
     w: Vec<f64>,
     reproject: bool,
@@ -172,6 +175,7 @@ impl Tracker {
                 other => other,
             })?)
         };
+        let ct = (!cons.is_empty()).then(|| cons.c.transpose());
         let solver = if cons.is_empty() {
             None
         } else {
@@ -186,6 +190,7 @@ impl Tracker {
             dropped_rows: pinned_rows,
             warnings,
             gram,
+            ct,
             w,
             reproject,
             scale,
@@ -219,8 +224,8 @@ impl Tracker {
         let v_pt: Vec<Pt3> = st.v.iter().map(|v| Pt3::from(*v)).collect();
         let mut gv = vec![Vec3::zeros(); k];
         cons.residual(&vb_pt, &v_pt, &mut gv);
-        let dq = self.mass_weighted_correction(&cons, &gq);
-        let dv = self.mass_weighted_correction(&cons, &gv);
+        let dq = self.mass_weighted_correction(&gq);
+        let dv = self.mass_weighted_correction(&gv);
         let q: Vec<Pt3> = st.q.iter().zip(&dq).map(|(p, d)| p + d).collect();
         let v: Vec<Vec3> = st.v.iter().zip(&dv).map(|(p, d)| p + d).collect();
         self.sim.set_state(ShellState { t: st.t, q, v })?;
@@ -229,13 +234,12 @@ impl Tracker {
 
     /// The smallest correction Δ in the mass metric with C Δ = g per coordinate:
     /// Δ = W Cᵀ G⁻¹ g, G = C W Cᵀ (the cached Gram factor), zero on pinned vertices.
-    fn mass_weighted_correction(&self, cons: &TrackingConstraints, g: &[Vec3]) -> Vec<Vec3> {
+    fn mass_weighted_correction(&self, g: &[Vec3]) -> Vec<Vec3> {
         let w = &self.w;
         let mut out = vec![Vec3::zeros(); w.len()];
-        let Some(gram) = self.gram.as_ref() else {
+        let (Some(gram), Some(ct)) = (self.gram.as_ref(), self.ct.as_ref()) else {
             return out;
         };
-        let ct = cons.c.transpose();
         for d in 0..3 {
             let mut y: Vec<f64> = g.iter().map(|x| x[d]).collect();
             gram.solve(&mut y);
@@ -250,24 +254,26 @@ impl Tracker {
     }
 
     /// §3.7 step 5: velocities corrected by W Ĉᵀ G⁻¹ g(q_{k+1}) / h, then the collision pass
-    /// again from q_k ([`ShellSim::recollide`]). Returns whether it ran (not when every
-    /// ‖g_i‖ ≤ 1e-12·L).
-    fn reproject_after_collisions(&mut self, h: f64) -> Result<bool> {
-        let Some(cons) = self.solver.as_ref().map(|s| s.constraints().clone()) else {
-            return Ok(false);
+    /// again from q_k ([`ShellSim::recollide`]). Returns the residual max_i ‖g_i‖ it started
+    /// from (m) and whether it ran (not when every ‖g_i‖ ≤ 1e-12·L).
+    fn reproject_after_collisions(&mut self, h: f64) -> Result<(f64, bool)> {
+        let Some(solver) = self.solver.as_ref() else {
+            return Ok((0.0, false));
         };
+        let cons = solver.constraints();
         let st = self.sim.state();
         self.guide.sample(st.t, &mut self.gbuf);
         let mut g = vec![Vec3::zeros(); cons.len()];
         cons.residual(&self.gbuf, &st.q, &mut g);
+        let first = g.iter().map(|x| x.norm()).fold(0.0, f64::max);
         // Already at solver precision (spec: r ≈ 1e-13·L): nothing to correct.
-        if g.iter().all(|x| x.norm() <= 1e-12 * self.scale) {
-            return Ok(false);
+        if first <= 1e-12 * self.scale {
+            return Ok((first, false));
         }
-        let dq = self.mass_weighted_correction(&cons, &g);
+        let dq = self.mass_weighted_correction(&g);
         let v: Vec<Vec3> = self.sim.state().v.iter().zip(&dq).map(|(v, d)| v + d / h).collect();
         self.sim.recollide(&v)?;
-        Ok(true)
+        Ok((first, true))
     }
 
     /// Current constraint residual max_i ‖g_i(q, t)‖ (m); 0 when K = 0.
@@ -305,8 +311,7 @@ impl Tracker {
             }
         }
         if self.reproject {
-            out.residual_post_first_pass = self.residual_now();
-            out.reprojected = self.reproject_after_collisions(h)?;
+            (out.residual_post_first_pass, out.reprojected) = self.reproject_after_collisions(h)?;
         }
         out.t_step = t0.elapsed().as_secs_f64();
         out.residual_post_collision = self.residual_now();

@@ -158,6 +158,15 @@ mod tests {
     use super::*;
     use geom_core::math::Pt3;
 
+    /// The pairs sorted, asserting that the broad phase listed none twice.
+    fn sorted_unique(mut v: Vec<(u32, u32)>, round: usize) -> Vec<(u32, u32)> {
+        let n = v.len();
+        v.sort_unstable();
+        v.dedup();
+        assert_eq!(v.len(), n, "round {round}: duplicate pairs");
+        v
+    }
+
     /// Tree candidates equal the brute-force list of overlapping, non-adjacent pairs, before and
     /// after a refit with moved boxes.
     #[test]
@@ -173,13 +182,8 @@ mod tests {
             let vb: Vec<Aabb> = pts.iter().map(|p| Aabb::from_points(&[*p]).grow(0.05)).collect();
             let tb: Vec<Aabb> = tris.iter().map(|t| Aabb::from_points(&t.map(|i| pts[i as usize]))).collect();
             let eb: Vec<Aabb> = edges.iter().map(|e| Aabb::from_points(&e.map(|i| pts[i as usize]))).collect();
-            let (mut vt, mut ee) = bp.candidate_pairs(&tris, &edges, &vb, &tb, &eb);
-            let (nvt, nee) = (vt.len(), ee.len());
-            vt.sort_unstable();
-            vt.dedup();
-            ee.sort_unstable();
-            ee.dedup();
-            assert_eq!((vt.len(), ee.len()), (nvt, nee), "round {round}: duplicates");
+            let (vt, ee) = bp.candidate_pairs(&tris, &edges, &vb, &tb, &eb);
+            let (vt, ee) = (sorted_unique(vt, round), sorted_unique(ee, round));
             let mut bvt = Vec::new();
             for (v, b) in vb.iter().enumerate() {
                 for (t, c) in tb.iter().enumerate() {
@@ -201,13 +205,8 @@ mod tests {
             assert_eq!(ee, bee, "round {round}");
             // The changed-vertex subset equals the full list filtered to pairs touching them.
             let changed: Vec<bool> = (0..n).map(|i| i % 7 == round).collect();
-            let (mut svt, mut see) = bp.candidate_pairs_touching(&tris, &edges, (&vb, &tb, &eb), &changed);
-            let (nvt, nee) = (svt.len(), see.len());
-            svt.sort_unstable();
-            svt.dedup();
-            see.sort_unstable();
-            see.dedup();
-            assert_eq!((svt.len(), see.len()), (nvt, nee), "round {round}: duplicates in the subset");
+            let (svt, see) = bp.candidate_pairs_touching(&tris, &edges, (&vb, &tb, &eb), &changed);
+            let (svt, see) = (sorted_unique(svt, round), sorted_unique(see, round));
             let c = |i: u32| changed[i as usize];
             let fvt: Vec<_> =
                 bvt.iter().copied().filter(|&(v, t)| c(v) || tris[t as usize].iter().any(|&i| c(i))).collect();
