@@ -13,6 +13,7 @@ use flip_tet::sim::{FlipTetSim, StepStats};
 use geom_core::io::{write_obj_frame, MeshOut};
 use serde::Deserialize;
 
+use super::flip_tet_snapshots::Snapshots;
 use crate::error::{Error, Result};
 use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
@@ -87,13 +88,14 @@ pub(crate) fn simulate(
     let mut csv = CsvWriter::create(&out.join("metrics.csv"), &CSV_HEADER)?;
     let mut all = Vec::new();
     let mut frame = 0u64;
-    let write_frame = |sim: &FlipTetSim, frame: u64| -> Result<()> {
+    let mut snaps = Snapshots::new(scene, out)?;
+    let mut write_frame = |sim: &FlipTetSim, frame: u64| -> Result<()> {
         if obj_every > 0 && frame.is_multiple_of(obj_every) {
             if let Some(m) = sim.surface() {
                 write_obj_frame(&out.join("frames"), (frame / obj_every) as usize, &MeshOut::from_tri_mesh(&m))?;
             }
         }
-        Ok(())
+        snaps.frame(sim, frame)
     };
     write_frame(&sim, 0)?;
     while sim.time() < scene.duration - 1e-9 {
@@ -106,7 +108,9 @@ pub(crate) fn simulate(
         }
         all.push(st);
     }
-    Ok((all, t0.elapsed().as_secs_f64(), sim))
+    let wall = t0.elapsed().as_secs_f64();
+    snaps.finish()?;
+    Ok((all, wall, sim))
 }
 
 fn common(s: &mut Summary, stats: &[StepStats], wall: f64) {

@@ -29,6 +29,7 @@ use geom_core::mesh::TriMesh;
 use geom_core::rng::Rng;
 use serde::Deserialize;
 
+use super::flip_tet_snapshots::Snapshots;
 use crate::error::{Error, Result};
 use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
@@ -562,7 +563,9 @@ fn run_splash(ctx: &RunCtx) -> Result<Summary> {
     let n_frames = (scene.duration * scene.fps).round().max(1.0) as usize;
     let snaps = [0, n_frames / 2, n_frames];
     let dir = ctx.out_dir.clone();
+    let mut rendered = Snapshots::new(&scene, &dir)?;
     let log = simulate(&scene, |sim, f| {
+        rendered.frame(sim, f as u64)?;
         if snaps.contains(&f) {
             levels_topview(&dir.join(format!("levels_topview_{f:04}.png")), sim.octree())?;
         }
@@ -574,6 +577,7 @@ fn run_splash(ctx: &RunCtx) -> Result<Summary> {
         }
         Ok(())
     })?;
+    rendered.finish()?;
     frames_csv(&ctx.out_dir.join("frames.csv"), &log)?;
     cost_plot(&ctx.out_dir.join("cost_per_frame.png"), "open splash: cost per frame", &[("adaptive", &log)])?;
     // Uniform baseline (spec §12 G11): 8 particles per finest cube over the liquid volume.
@@ -615,7 +619,9 @@ fn run_corridor(ctx: &RunCtx) -> Result<Summary> {
     // them are at least r_max / 2.
     let (mut outside, mut outside_coarse) = (0usize, 0usize);
     let dir = ctx.out_dir.clone();
+    let mut rendered = Snapshots::new(&scene, &dir)?;
     let on = simulate(&scene, |sim, f| {
+        rendered.frame(sim, f as u64)?;
         let fr = vis.frustum(sim.time());
         let p = sim.particles();
         let r_max = sim.spec().h_root / flip_tet::sizing::C_H;
@@ -632,6 +638,7 @@ fn run_corridor(ctx: &RunCtx) -> Result<Summary> {
         }
         Ok(())
     })?;
+    rendered.finish()?;
     let mut off_scene = scene.clone();
     off_scene.sizing.visibility = None;
     let off = simulate(&off_scene, |_, _| Ok(()))?;

@@ -4,6 +4,7 @@ pub mod barnet;
 pub mod curve_skin;
 pub mod flip_tet;
 pub mod flip_tet_adaptive;
+pub mod flip_tet_snapshots;
 pub mod geom_core;
 pub mod motion_graph;
 pub mod rigging;
