@@ -378,7 +378,7 @@ impl FlipTetSim {
                 };
                 let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
                 ctx.surface = curv.as_ref();
-                let demands = Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx));
+                let demands = Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx), None);
                 let mut next = build_octree(spec, &demands);
                 if scene.extra_grading_layers > 0 {
                     balance_2to1(&mut next, scene.extra_grading_layers);
@@ -447,6 +447,9 @@ impl FlipTetSim {
         Ok(())
     }
 
+    /// One size demand per non-ballistic particle (spec §3.12); with `prev` (the octree being
+    /// replaced) and `sizing.temporal_smoothing` each radius is limited to twice the radius of
+    /// the particle's current leaf.
     fn demands_static(
         scene: &Scene,
         spec: &OctreeSpec,
@@ -454,15 +457,21 @@ impl FlipTetSim {
         parts: &Particles,
         dt: f64,
         ctx_extra: Option<&SizingContext>,
+        prev: Option<&Octree>,
     ) -> Vec<SizeDemand> {
         let base = SizingContext::new(spec.h_min(), spec.h_root);
         let ctx = ctx_extra.copied().unwrap_or(base);
         let (r_min, r_max) = (spec.h_min() / C_H, spec.h_root / C_H);
+        let prev = prev.filter(|_| scene.sizing.temporal_smoothing);
         (0..parts.len())
             .into_par_iter()
             .filter(|&i| !parts.is_ballistic(i))
             .map(|i| {
-                let s = sizing.radius_at_phi(&parts.x[i], Some(parts.phi[i]), &ctx).clamp(r_min, r_max);
+                let mut s = sizing.radius_at_phi(&parts.x[i], Some(parts.phi[i]), &ctx);
+                if let Some(o) = prev {
+                    s = s.min(2.0 * o.leaf_h(o.leaf_at(&parts.x[i])) / C_H);
+                }
+                let s = s.clamp(r_min, r_max);
                 let level = spec.level_for_size(C_H * s);
                 let h = spec.h(level);
                 let pad = (2.0 * h).max(f64::from(scene.flip.remesh_interval) * dt * parts.v[i].norm());
@@ -607,7 +616,15 @@ impl FlipTetSim {
         if !self.scene.obstacles.is_empty() {
             ctx.solid_sdf = Some(&solid);
         }
-        let demands = Self::demands_static(&self.scene, &self.spec, &self.sizing, &self.parts, dt, Some(&ctx));
+        let demands = Self::demands_static(
+            &self.scene,
+            &self.spec,
+            &self.sizing,
+            &self.parts,
+            dt,
+            Some(&ctx),
+            Some(&self.octree),
+        );
         let mut oct = build_octree(self.spec, &demands);
         if self.scene.extra_grading_layers > 0 {
             balance_2to1(&mut oct, self.scene.extra_grading_layers);
@@ -1145,6 +1162,40 @@ mod tests {
                     assert!(p <= e + 1e-12, "node {i}: {p} shallower than {e}");
                     assert!(-p <= 1.25 * -e + 0.25, "node {i}: {p} far deeper than {e}");
                 }
+            }
+        }
+    }
+
+    /// Temporal sizing smoothing (spec §3.12, opt-in): with every particle in a finest leaf and
+    /// a sizing that asks for the coarsest radius below the surface band, the demands fall at
+    /// most one level below the finest (`S ≤ 2 S_prev`); without it the deep particles demand
+    /// levels two or more below, and the off switch changes nothing else.
+    #[test]
+    fn temporal_smoothing_limits_coarsening_to_one_level() {
+        let text = |on: bool| {
+            format!(
+                r#"(domain: (min: (0.0, 0.0, 0.0), max: (1.0, 1.0, 1.0)),
+                resolution: (coarsest: 2, finest: 16), duration: 0.1, fps: 60.0,
+                liquid: [Box(min: (0.0, 0.0, 0.0), max: (1.0, 0.5, 1.0))],
+                sizing: (depth_floor: Some(2.0), surface_band: Some(2.0), temporal_smoothing: {on}))"#
+            )
+        };
+        let levels = |on: bool| {
+            let scene: Scene = ron::from_str(&text(on)).unwrap();
+            let sim = FlipTetSim::new(&scene).unwrap();
+            let fine = Octree::uniform(sim.spec, sim.spec.levels - 1);
+            let d = FlipTetSim::demands_static(&scene, &sim.spec, &sim.sizing, &sim.parts, 0.01, None, Some(&fine));
+            d.iter().map(|x| x.level).collect::<Vec<u8>>()
+        };
+        let finest = FlipTetSim::new(&ron::from_str::<Scene>(&text(false)).unwrap()).unwrap().spec.levels - 1;
+        let (off, on) = (levels(false), levels(true));
+        assert_eq!(off.len(), on.len());
+        assert!(off.iter().any(|&l| l + 2 <= finest), "without smoothing some demand is ≥ 2 levels coarser");
+        assert!(on.iter().all(|&l| l + 1 >= finest), "with smoothing every demand within one level");
+        // Where the sizing asks for at most one level of coarsening, smoothing changes nothing.
+        for (a, b) in off.iter().zip(&on) {
+            if a + 1 >= finest {
+                assert_eq!(a, b);
             }
         }
     }

@@ -38,6 +38,10 @@ pub struct SizingParams {
     pub surface_band: Option<f64>,
     /// User boxes with radii; `None` = off.
     pub user: Option<Vec<UserBox>>,
+    /// Temporal smoothing (spec §3.12, optional): at a remesh a particle's demanded radius is
+    /// limited to twice the radius of the leaf it sits in, `S ← min(S, 2 S_prev)`, so that
+    /// resolution is thrown away at most one level per remesh. Off by default.
+    pub temporal_smoothing: bool,
 }
 
 impl Default for SizingParams {
@@ -50,6 +54,7 @@ impl Default for SizingParams {
             depth_floor: Some(0.25),
             surface_band: None,
             user: None,
+            temporal_smoothing: false,
         }
     }
 }
