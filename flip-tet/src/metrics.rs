@@ -156,7 +156,7 @@ pub fn interp(table: &[(f64, f64)], x: f64) -> f64 {
 }
 
 /// Column names of [`csv_row`].
-pub const CSV_HEADER: [&str; 28] = [
+pub const CSV_HEADER: [&str; 29] = [
     "step",
     "t",
     "dt",
@@ -179,6 +179,7 @@ pub const CSV_HEADER: [&str; 28] = [
     "potential_energy",
     "max_speed",
     "cfl_substeps",
+    "budget_hit",
     "t_remesh",
     "t_transfer",
     "t_solve",
@@ -213,6 +214,7 @@ pub fn csv_row(s: &StepStats) -> Vec<f64> {
         s.potential_energy,
         s.max_speed,
         f64::from(s.cfl_substeps),
+        f64::from(u8::from(s.budget_hit)),
         st[0],
         st[1],
         st[2],

@@ -80,8 +80,12 @@ pub struct StepStats {
     pub t: f64,
     /// Step size (s).
     pub dt: f64,
-    /// Whether the mesh was rebuilt in this step.
+    /// Whether the remesh stage ran in this step (every `remesh_interval` steps; the mesh itself
+    /// is kept when it cannot change, see `remesh`).
     pub remeshed: bool,
+    /// Whether the particle budget (`particles.max_particles`) stopped splitting at this step's
+    /// remesh (spec §3.10; with `budget_is_error` the step returns an error instead).
+    pub budget_hit: bool,
     /// Whether the step ended on a frame boundary.
     pub frame_end: bool,
     /// Particles.
@@ -578,6 +582,7 @@ impl FlipTetSim {
     /// uniform 64). The particle locations and `φ` are redone either way, so that the results
     /// do not depend on the shortcut.
     fn remesh(&mut self, dt: f64) -> Result<(usize, usize)> {
+        self.budget_hit = false;
         if self.spec.levels == 1 {
             self.relocate_from_scratch();
             self.phi = self.level_set();
@@ -789,6 +794,7 @@ impl FlipTetSim {
             st.n_split = ns;
             st.n_merge = nm;
             st.remeshed = true;
+            st.budget_hit = self.budget_hit;
             self.store_particle_phi();
             tm.remesh = c.elapsed().as_secs_f64();
         }
