@@ -18,7 +18,7 @@ use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
 use crate::registry::BenchCtx;
 use crate::scene::{scenes_dir, Mode};
-use crate::scenes::flip_tet::{front_errors, load_file, simulate};
+use crate::scenes::flip_tet::{front_errors, load_file, simulate, FrameOutput};
 
 struct Row {
     knob: &'static str,
@@ -37,7 +37,7 @@ fn dam_break(scene: &Scene, dir: &Path) -> Result<(f64, f64, usize, f64)> {
     };
     let g = -scene.gravity[1];
     let mut front = Vec::new();
-    let (stats, wall, _) = simulate(scene, dir, 0, &mut |sim, st| {
+    let (stats, wall, _) = simulate(scene, dir, FrameOutput { obj: 0, ply: 0 }, &mut |sim, st| {
         front.push((st.t * (2.0 * g / a).sqrt(), metrics::front_position(sim.particles(), scene.domain.min[0]) / a));
     })?;
     let (_, rms) = front_errors(&front);
@@ -46,7 +46,7 @@ fn dam_break(scene: &Scene, dir: &Path) -> Result<(f64, f64, usize, f64)> {
 }
 
 fn rest(scene: &Scene, dir: &Path) -> Result<(f64, f64, f64, usize)> {
-    let (stats, wall, _) = simulate(scene, dir, 0, &mut |_, _| {})?;
+    let (stats, wall, _) = simulate(scene, dir, FrameOutput { obj: 0, ply: 0 }, &mut |_, _| {})?;
     let vmax = stats.iter().map(|x| x.max_speed).fold(0.0, f64::max);
     let v0 = stats.first().map_or(1.0, |x| x.vol_levelset);
     let drift = stats.iter().map(|x| (x.vol_levelset - v0).abs()).fold(0.0, f64::max) / v0.max(1e-300);
@@ -63,7 +63,7 @@ fn wave(scene: &Scene, dir: &Path) -> Result<(f64, f64, usize)> {
     let t_th = 2.0 * std::f64::consts::PI / (g * k * (k * (mean - scene.domain.min[1])).tanh()).sqrt();
     let zc = 0.5 * (scene.domain.min[2] + scene.domain.max[2]);
     let mut eta = Vec::new();
-    let (stats, wall, _) = simulate(scene, dir, 0, &mut |sim, st| {
+    let (stats, wall, _) = simulate(scene, dir, FrameOutput { obj: 0, ply: 0 }, &mut |sim, st| {
         if let Some(h) = metrics::surface_height(sim, scene.domain.min[0] + sim.spec().h_min() / 2.0, zc) {
             eta.push((st.t, h));
         }
