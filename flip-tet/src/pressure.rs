@@ -207,6 +207,23 @@ fn edge_ghost(c: &[f64; 4], liq: &[bool; 4], phi: [f64; 4], g: usize, lambda_min
     (dg, theta)
 }
 
+/// Adds the edge-wise ghost of air vertex `g` ([`edge_ghost`]) to the tet's ghost term `delta`
+/// (diagonal only) and returns its ghost record `(g, scale 1, θ = w s, mixed-sign)`.
+fn add_edge_ghost(
+    delta: &mut [[f64; 4]; 4],
+    c: &[f64; 4],
+    liq: &[bool; 4],
+    phi: [f64; 4],
+    g: usize,
+    lambda_min: f64,
+) -> (u8, f64, [f64; 4], bool) {
+    let (dg, w) = edge_ghost(c, liq, phi, g, lambda_min);
+    for l in 0..4 {
+        delta[l][l] += dg[l];
+    }
+    (g as u8, 1.0, w, true)
+}
+
 /// Assembles the pressure system for the intermediate velocity `u_star` (per tet) and node level
 /// set `phi` (spec §3.4–3.6).
 pub fn assemble_pressure(
@@ -281,6 +298,7 @@ pub fn assemble_pressure(
             continue;
         }
         let h_t = mesh.volume[t].cbrt();
+        let phi_t = tv.map(|i| phi_s[i as usize]);
         let mut delta = [[0.0; 4]; 4];
         let mut local_ghosts: Vec<(u8, f64, [f64; 4], bool)> = Vec::new();
         let mut first_order = false;
@@ -302,7 +320,7 @@ pub fn assemble_pressure(
             } else if csum > -1e-10 * kt[gi][gi].abs() {
                 // Mixed-sign couplings (obtuse transition tets): θ = c/C is undefined, but the
                 // ghost weights w = s θ = φ_g c / (cᵀφ) are not (see `mixed_sign_weights`).
-                match mixed_sign_weights(&c, tv.map(|i| phi_s[i as usize]), gi, h_t, p.min_interface_fraction) {
+                match mixed_sign_weights(&c, phi_t, gi, h_t, p.min_interface_fraction) {
                     Some((sigma, w)) => {
                         for i in 0..4 {
                             for j in 0..4 {
@@ -312,11 +330,7 @@ pub fn assemble_pressure(
                         local_ghosts.push((gi as u8, 1.0, w, true));
                     }
                     None if p.ghost_fallback == GhostFallback::EdgeWise => {
-                        let (dg, w) = edge_ghost(&c, &liq, tv.map(|i| phi_s[i as usize]), gi, p.min_interface_fraction);
-                        for l in 0..4 {
-                            delta[l][l] += dg[l];
-                        }
-                        local_ghosts.push((gi as u8, 1.0, w, true));
+                        local_ghosts.push(add_edge_ghost(&mut delta, &c, &liq, phi_t, gi, p.min_interface_fraction));
                     }
                     None => {
                         // cᵀφ ≤ 0: the symmetric ghost term would be negative definite. The whole
@@ -331,14 +345,10 @@ pub fn assemble_pressure(
             } else {
                 std::array::from_fn(|l| c[l] / csum)
             };
-            let phit: f64 = (0..4).map(|l| theta[l] * phi_s[tv[l] as usize]).sum();
+            let phit: f64 = (0..4).map(|l| theta[l] * phi_t[l]).sum();
             if phit >= -1e-12 * h_t && p.ghost_fallback == GhostFallback::EdgeWise && coupled {
                 // Negative θ weights with φ̃ ≥ 0, i.e. cᵀφ = C φ̃ ≤ 0: as above.
-                let (dg, w) = edge_ghost(&c, &liq, tv.map(|i| phi_s[i as usize]), gi, p.min_interface_fraction);
-                for l in 0..4 {
-                    delta[l][l] += dg[l];
-                }
-                local_ghosts.push((gi as u8, 1.0, w, true));
+                local_ghosts.push(add_edge_ghost(&mut delta, &c, &liq, phi_t, gi, p.min_interface_fraction));
                 continue;
             }
             if phit >= -1e-12 * h_t {
@@ -346,7 +356,7 @@ pub fn assemble_pressure(
                 local_ghosts.push((gi as u8, 0.0, [0.0; 4], false));
                 continue;
             }
-            let phig = phi_s[tv[gi] as usize];
+            let phig = phi_t[gi];
             let lam = (phit / (phit - phig)).max(p.min_interface_fraction);
             let s = -(1.0 - lam) / lam;
             if coupled {

@@ -583,11 +583,26 @@ impl FlipTetSim {
     /// do not depend on the shortcut.
     fn remesh(&mut self, dt: f64) -> Result<(usize, usize)> {
         self.budget_hit = false;
-        if self.spec.levels == 1 {
-            self.relocate_from_scratch();
-            self.phi = self.level_set();
-            return Ok((0, 0));
+        let (mut ns, mut nm) = (0, 0);
+        if self.spec.levels > 1 {
+            let oct = self.next_octree(dt);
+            // Keep the old mesh's φ for the split/merge snap.
+            if self.scene.particles.split_merge {
+                (ns, nm) = self.split_merge(&oct)?;
+            }
+            if ns > 0 || nm > 0 || oct.leaves != self.octree.leaves {
+                self.set_mesh(oct)?;
+            }
         }
+        // Locations from scratch (a particle on a shared face lands in the tet a rebuild gives)
+        // and φ (its interior radii read the particle φ stored since step 2), kept mesh or not.
+        self.relocate_from_scratch();
+        self.phi = self.level_set();
+        Ok((ns, nm))
+    }
+
+    /// The octree the sizing demands now (spec §3.12), balanced with the scene's extra layers.
+    fn next_octree(&self, dt: f64) -> Octree {
         let needs_surface = self.sizing.needs_surface();
         let curv = if needs_surface {
             let tri = crate::surface::marching_tets(&self.mesh, &self.phi).ok();
@@ -634,25 +649,7 @@ impl FlipTetSim {
         if self.scene.extra_grading_layers > 0 {
             balance_2to1(&mut oct, self.scene.extra_grading_layers);
         }
-        let (mut ns, mut nm) = (0, 0);
-        // Keep the old mesh's φ for the split/merge snap.
-        if self.scene.particles.split_merge && self.spec.levels > 1 {
-            let (a, b) = self.split_merge(&oct)?;
-            ns = a;
-            nm = b;
-        }
-        if ns == 0 && nm == 0 && oct.leaves == self.octree.leaves {
-            // Same mesh, same particles: only the locations (so that a particle on a shared
-            // face lands in the same tet as after a rebuild) and φ (its interior radii read the
-            // particle φ stored since step 2) are redone.
-            self.relocate_from_scratch();
-            self.phi = self.level_set();
-            return Ok((0, 0));
-        }
-        self.set_mesh(oct)?;
-        self.relocate_from_scratch();
-        self.phi = self.level_set();
-        Ok((ns, nm))
+        oct
     }
 
     /// Locates every particle without its previous tet (after a mesh change).
