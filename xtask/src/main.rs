@@ -62,6 +62,10 @@ enum Cmd {
         /// Output directory (default out/bench/<crate>).
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
+        /// Run only this sweep of the bench (flip-tet: resolution, levels, tol, bc, solver, remesh,
+        /// cfl, pic, surface; or all).
+        #[arg(long, value_name = "KNOB")]
+        sweep: Option<String>,
     },
     /// Prints what a mesh (OBJ/PLY/OFF) or motion (BVH) file holds, or why it cannot be read.
     Inspect {
@@ -97,9 +101,9 @@ fn main() -> ExitCode {
     let result = match cli.cmd {
         Cmd::List => list(),
         Cmd::Run { target, quick, full, out } => run_one(&target, mode(quick, full), out),
-        Cmd::Bench { krate, quick, out } => {
+        Cmd::Bench { krate, quick, out, sweep } => {
             let dir = out.unwrap_or_else(|| out::default_out_root().join("bench").join(&krate));
-            run::run_bench(&krate, quick, &dir).map(|s| {
+            run::run_bench(&krate, quick, sweep.as_deref(), &dir).map(|s| {
                 println!("bench {krate}: {}", dir.display());
                 run::print_summary(&s);
             })

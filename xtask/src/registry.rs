@@ -38,6 +38,9 @@ pub struct BenchCtx {
     pub quick: bool,
     /// `out/bench/<crate>/` (created before the benchmark is called).
     pub out_dir: PathBuf,
+    /// `--sweep <knob>`: run only this sweep (one of the bench's [`Bench::sweeps`], or `all`);
+    /// `None` runs the bench's default set.
+    pub sweep: Option<String>,
 }
 
 /// An accuracy-versus-time benchmark of one crate.
@@ -48,6 +51,8 @@ pub struct Bench {
     pub description: &'static str,
     /// The entry point: writes CSV and PNG into `out_dir` and returns the summary figures.
     pub run: fn(&BenchCtx) -> Result<Summary>,
+    /// The sweeps `--sweep <knob>` can select (empty: the bench has one fixed sweep).
+    pub sweeps: &'static [&'static str],
 }
 
 /// Every scene runner of every crate.
@@ -73,41 +78,49 @@ pub fn benches() -> Vec<Bench> {
             crate_name: "geom-core",
             description: "sparse solvers: direct factorisation, refactorisation and IC(0)-PCG on Laplacian + mass systems",
             run: crate::bench_geom_core::run,
+            sweeps: &[],
         },
         Bench {
             crate_name: "barnet",
             description: "bar-net: membrane resolution vs shape error and time per frame; Catmull-Clark level vs error and arm frame time",
             run: crate::bench_barnet::run,
+            sweeps: &[],
         },
         Bench {
             crate_name: "curve-skin",
             description: "curve skinning: frame-table size, LBS influence count and method cost against accuracy",
             run: crate::bench_curve_skin::run,
+            sweeps: &[],
         },
         Bench {
             crate_name: "rigging",
             description: "automatic rigging: tau, packing cap and refinement iterations vs embedding success, joint error and time",
             run: crate::bench_rigging::run,
+            sweeps: &[],
         },
         Bench {
             crate_name: "shells",
             description: "substeps × Newton iterations × Hessian mode on drape and wind-flag: error vs ms/frame",
             run: crate::bench_shells::run,
+            sweeps: &[],
         },
         Bench {
             crate_name: "tracks",
             description: "tracks: 16 … 1024 clustered regions on the Xavier clip, deviation and wavelength vs time per frame",
             run: crate::bench_tracks::run,
+            sweeps: &[],
         },
         Bench {
             crate_name: "motion-graph",
             description: "motion graphs: search budget vs constraint error (hierarchy on/off), graph density, database size, smoothing window",
             run: crate::bench_motion_graph::run,
+            sweeps: &[],
         },
         Bench {
             crate_name: "flip-tet",
             description: "flip-tet: resolution, adaptivity levels, solver tolerance and boundary order vs dam-break front error, rest speed and time",
             run: crate::bench_flip_tet::run,
+            sweeps: crate::bench_flip_tet::SWEEPS,
         },
     ]
 }

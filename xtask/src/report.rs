@@ -48,7 +48,7 @@ pub fn repro(mode: Mode, out_root: PathBuf) -> Result<()> {
         bar.set_message(id.clone());
         let dir = out_root.join("bench").join(b.crate_name);
         let t = Instant::now();
-        let r = run_bench(b.crate_name, mode == Mode::Quick, &dir);
+        let r = run_bench(b.crate_name, mode == Mode::Quick, None, &dir);
         let o = Outcome {
             id,
             description: b.description.to_string(),

@@ -42,16 +42,30 @@ pub fn run_scene(scene_id: &str, file: &Path, mode: Mode, out_dir: &Path) -> Res
     Ok(summary)
 }
 
-/// Runs the benchmark of `crate_name` into `out_dir`; writes `summary.json`.
-pub fn run_bench(crate_name: &str, quick: bool, out_dir: &Path) -> Result<Summary> {
+/// Runs the benchmark of `crate_name` into `out_dir`; writes `summary.json`. `sweep` selects one
+/// of the bench's sweeps (`--sweep <knob>`, or `all`); an unknown knob is a usage error naming the
+/// known ones.
+pub fn run_bench(crate_name: &str, quick: bool, sweep: Option<&str>, out_dir: &Path) -> Result<Summary> {
     let benches = registry::benches();
     let bench = benches.iter().find(|b| b.crate_name == crate_name).ok_or_else(|| {
         let known: Vec<&str> = benches.iter().map(|b| b.crate_name).collect();
         Error::Usage(format!("no benchmark for '{crate_name}'; known: {}", known.join(", ")))
     })?;
+    if let Some(k) = sweep {
+        if bench.sweeps.is_empty() {
+            return Err(Error::Usage(format!("the '{crate_name}' benchmark has one fixed sweep; drop --sweep {k}")));
+        }
+        if k != "all" && !bench.sweeps.contains(&k) {
+            return Err(Error::Usage(format!(
+                "no sweep '{k}' in the '{crate_name}' benchmark; known: {}, all",
+                bench.sweeps.join(", ")
+            )));
+        }
+    }
     ensure_dir(out_dir)?;
     let t0 = Instant::now();
-    let mut summary = (bench.run)(&BenchCtx { quick, out_dir: out_dir.to_path_buf() })?;
+    let ctx = BenchCtx { quick, out_dir: out_dir.to_path_buf(), sweep: sweep.map(str::to_string) };
+    let mut summary = (bench.run)(&ctx)?;
     summary.set("wall_s", t0.elapsed().as_secs_f64());
     summary.set_str("mode", if quick { "quick" } else { "default" });
     summary.write(out_dir)?;

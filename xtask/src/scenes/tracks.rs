@@ -1057,6 +1057,8 @@ pub(crate) struct PartitionRow {
     pub r_pre: f64,
     pub nnz_l: usize,
     pub clustering_s: f64,
+    /// Mean KKT solve time per step (s).
+    pub solve_s_per_step: f64,
 }
 
 /// Runs the Xavier clip with uniform clusterings of each size (spec §6.7).
@@ -1104,6 +1106,7 @@ pub(crate) fn partition_study(
             r_pre: out.max_r_pre / out.scale,
             nnz_l: out.nnz_l,
             clustering_s,
+            solve_s_per_step: out.t_kkt / out.steps.max(1) as f64,
         });
     }
     Ok(rows)
@@ -1123,6 +1126,7 @@ pub(crate) fn write_partition_outputs(rows: &[PartitionRow], dir: &Path) -> Resu
             "r_pre_over_L",
             "nnz_l",
             "clustering_s",
+            "solve_s_per_step",
         ],
     )?;
     for r in rows {
@@ -1137,6 +1141,7 @@ pub(crate) fn write_partition_outputs(rows: &[PartitionRow], dir: &Path) -> Resu
             Cell::Num(r.r_pre),
             Cell::Int(r.nnz_l as i64),
             Cell::Num(r.clustering_s),
+            Cell::Num(r.solve_s_per_step),
         ])?;
     }
     let xy = |f: &dyn Fn(&PartitionRow) -> (f64, f64)| rows.iter().map(f).collect::<Vec<_>>();
