@@ -2,7 +2,7 @@
 //! coverage mask, extrapolation through nodal averages, nodal averages with free slip at box
 //! walls, the sub-tet interpolation `I(x) = 4 m u_t + Σ_a (λ_a − m) ũ_a`, and the PIC/FLIP blend.
 
-use geom_core::math::Vec3;
+use geom_core::math::{Pt3, Vec3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -59,40 +59,98 @@ pub fn particles_to_tets(mesh: &TetMesh, h_tet: &[f64], parts: &Particles, p: &T
     // on uniform 32: 5.9 s vs 0.05 s per step), and its `within` lists the same indices in the
     // same order as `KdTree::within` (P2G 5.5 s → 4.2 s on dam-break default, session 6).
     let occ = crate::surface::SphereTree::build(&parts.x, &vec![0.0; parts.len()]);
-    let res: Vec<(Vec3, bool, f64)> = (0..mesh.tets.len())
-        .into_par_iter()
-        .map_init(Vec::new, |buf, t| {
-            let c = mesh.centroid[t];
-            let rad = p.support * h_tet[t];
-            // `within` returns the indices sorted ascending (fixed summation order); an empty
-            // list (air tets far from every particle) gives the (0, invalid, 0) result.
-            occ.within(&c, rad, buf);
-            let (mut sw, mut sv) = (0.0, Vec3::zeros());
-            for &i in buf.iter() {
-                let i = i as usize;
-                if parts.flags[i].has(ParticleFlags::BALLISTIC) {
-                    continue;
-                }
-                let w = parts.volume(i) * w_smooth((parts.x[i] - c).norm(), rad);
-                sw += w;
-                sv += parts.v[i] * w;
-            }
-            let vref = (0.5 * h_tet[t]).powi(3);
-            let cov = sw / vref;
-            if cov >= p.omega_valid && sw > 0.0 {
-                (sv / sw, true, cov)
-            } else if sw > 0.0 {
-                (sv / sw, false, cov)
-            } else {
-                (Vec3::zeros(), false, 0.0)
-            }
-        })
+    // One tree query per group of nearby tets (the tets owned by one octree leaf, see
+    // `tet_groups`) with a ball containing every tet's support ball, then each tet keeps the
+    // candidates that pass `within`'s own test `dx² + dy² + dz² ≤ rad²` (same expression, same
+    // rounding) in the same ascending order: the same particles summed in the same order as a
+    // `within` query per tet, so the result is bitwise the same (session 9).
+    let groups = tet_groups(mesh);
+    let per_group: Vec<Vec<(u32, (Vec3, bool, f64))>> = groups
+        .par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(cand, buf): &mut (Vec<u32>, Vec<u32>), g| {
+                let (centre, big) =
+                    covering_ball(g.iter().map(|&t| (mesh.centroid[t as usize], p.support * h_tet[t as usize])));
+                occ.within(&centre, big, cand);
+                g.iter()
+                    .map(|&t| {
+                        let c = mesh.centroid[t as usize];
+                        let rad = p.support * h_tet[t as usize];
+                        let r2 = rad * rad;
+                        buf.clear();
+                        buf.extend(cand.iter().copied().filter(|&i| {
+                            let x = &parts.x[i as usize];
+                            let (dx, dy, dz) = (c.x - x.x, c.y - x.y, c.z - x.z);
+                            dx * dx + dy * dy + dz * dz <= r2
+                        }));
+                        (t, tet_average(parts, c, rad, 0.5 * h_tet[t as usize], buf, p.omega_valid))
+                    })
+                    .collect()
+            },
+        )
         .collect();
+    let mut res = vec![(Vec3::zeros(), false, 0.0); mesh.tets.len()];
+    for (t, r) in per_group.into_iter().flatten() {
+        res[t as usize] = r;
+    }
     TetVelocity {
         u: res.iter().map(|r| r.0).collect(),
         valid: res.iter().map(|r| r.1).collect(),
         coverage: res.iter().map(|r| r.2).collect(),
     }
+}
+
+/// The P2G average of one tet from its support-ball particles `ids` (ascending: a fixed
+/// summation order): `(u, valid, coverage)`, coverage in units of `v_ref = half_h³`; ballistic
+/// particles are skipped; an empty sum gives `(0, invalid, 0)`.
+fn tet_average(parts: &Particles, c: Pt3, rad: f64, half_h: f64, ids: &[u32], omega_valid: f64) -> (Vec3, bool, f64) {
+    let (mut sw, mut sv) = (0.0, Vec3::zeros());
+    for &i in ids {
+        let i = i as usize;
+        if parts.flags[i].has(ParticleFlags::BALLISTIC) {
+            continue;
+        }
+        let w = parts.volume(i) * w_smooth((parts.x[i] - c).norm(), rad);
+        sw += w;
+        sv += parts.v[i] * w;
+    }
+    let cov = sw / half_h.powi(3);
+    if sw > 0.0 {
+        (sv / sw, cov >= omega_valid, cov)
+    } else {
+        (Vec3::zeros(), false, 0.0)
+    }
+}
+
+/// Partition of the tets into groups of neighbours for the gather: each tet goes to the
+/// lowest-numbered octree leaf whose centre is one of its vertices (nodes `0..n_leaves` are the
+/// leaf centres, `TetMesh::leaf_tets`); a tet with no centre vertex is a group of its own.
+fn tet_groups(mesh: &TetMesh) -> Vec<Vec<u32>> {
+    let n_leaves = mesh.leaf_tets.len();
+    let mut groups: Vec<Vec<u32>> = vec![Vec::new(); n_leaves];
+    for (t, tv) in mesh.tets.iter().enumerate() {
+        match tv.iter().copied().filter(|&v| (v as usize) < n_leaves).min() {
+            Some(l) => groups[l as usize].push(t as u32),
+            None => groups.push(vec![t as u32]),
+        }
+    }
+    groups.retain(|g| !g.is_empty());
+    groups
+}
+
+/// A ball containing every ball `(c, r)` of `balls`: centred at the mean centre, radius the
+/// largest `|c − centre| + r`, enlarged by a relative `1e−12` so that rounding in the containing
+/// query cannot drop a point that a member ball's own test keeps.
+fn covering_ball(balls: impl Iterator<Item = (Pt3, f64)> + Clone) -> (Pt3, f64) {
+    let (mut s, mut n) = (Vec3::zeros(), 0usize);
+    for (c, _) in balls.clone() {
+        s += c.coords;
+        n += 1;
+    }
+    let centre = Pt3::from(s / n.max(1) as f64);
+    let r = balls.map(|(c, r)| (c - centre).norm() + r).fold(0.0, f64::max);
+    (centre, r * (1.0 + 1e-12) + f64::MIN_POSITIVE)
 }
 
 /// Weak-coverage blend (spec §3.7): every valid tet with coverage `Ω < ω_blend` (in units of
@@ -357,6 +415,47 @@ mod tests {
         assert!(tv.valid.iter().all(|&v| v));
         for u in &tv.u {
             assert!((u - c).norm() < 1e-14);
+        }
+    }
+
+    /// The grouped gather of `particles_to_tets` (one query per leaf group, then each tet's own
+    /// radius test) gives bitwise the result of one `SphereTree::within` query per tet (the
+    /// session-8 code path, rebuilt here as the reference) on a graded mesh with 600 random
+    /// particles of mixed radii and velocities, some ballistic, and with a wide support (2 h_t)
+    /// where groups overlap most.
+    #[test]
+    fn grouped_gather_equals_per_tet_queries_bitwise() {
+        let (_, m) = mesh();
+        let mut rng = geom_core::rng::Rng::new(11);
+        let mut parts = Particles::default();
+        for i in 0..600 {
+            let x = Pt3::new(rng.range(0.0, 1.0), rng.range(0.0, 0.7), rng.range(0.0, 1.0));
+            parts.x.push(x);
+            parts.v.push(rng.unit_vec3() * rng.range(0.1, 2.0));
+            parts.r.push(rng.range(0.01, 0.05));
+            parts.phi.push(-rng.range(0.0, 0.2));
+            let mut f = ParticleFlags::default();
+            if i % 37 == 0 {
+                f.0 |= ParticleFlags::BALLISTIC;
+            }
+            parts.flags.push(f);
+            parts.tet.push(geom_core::NONE);
+        }
+        let h: Vec<f64> = m.tet_level.iter().map(|&l| 0.5 / f64::from(1u32 << l)).collect();
+        for support in [1.0, 2.0] {
+            let tp = TransferParams { support, ..TransferParams::default() };
+            let got = particles_to_tets(&m, &h, &parts, &tp);
+            let occ = crate::surface::SphereTree::build(&parts.x, &vec![0.0; parts.len()]);
+            let mut buf = Vec::new();
+            for t in 0..m.tets.len() {
+                let (c, rad) = (m.centroid[t], support * h[t]);
+                occ.within(&c, rad, &mut buf);
+                let want = tet_average(&parts, c, rad, 0.5 * h[t], &buf, tp.omega_valid);
+                assert_eq!(got.u[t], want.0, "tet {t}");
+                assert_eq!(got.valid[t], want.1);
+                assert_eq!(got.coverage[t].to_bits(), want.2.to_bits());
+            }
+            assert!(got.valid.iter().any(|&v| v) && got.valid.iter().any(|&v| !v));
         }
     }
 }
