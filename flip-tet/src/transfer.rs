@@ -65,7 +65,7 @@ pub fn particles_to_tets(mesh: &TetMesh, h_tet: &[f64], parts: &Particles, p: &T
     // rounding) in the same ascending order: the same particles summed in the same order as a
     // `within` query per tet, so the result is bitwise the same (session 9).
     let groups = tet_groups(mesh);
-    let per_group: Vec<Vec<(u32, (Vec3, bool, f64))>> = groups
+    let per_group: Vec<Vec<(u32, TetP2g)>> = groups
         .par_iter()
         .map_init(
             || (Vec::new(), Vec::new()),
@@ -101,10 +101,13 @@ pub fn particles_to_tets(mesh: &TetMesh, h_tet: &[f64], parts: &Particles, p: &T
     }
 }
 
+/// One tet's P2G result: `(u, valid, coverage)`.
+type TetP2g = (Vec3, bool, f64);
+
 /// The P2G average of one tet from its support-ball particles `ids` (ascending: a fixed
 /// summation order): `(u, valid, coverage)`, coverage in units of `v_ref = half_h³`; ballistic
 /// particles are skipped; an empty sum gives `(0, invalid, 0)`.
-fn tet_average(parts: &Particles, c: Pt3, rad: f64, half_h: f64, ids: &[u32], omega_valid: f64) -> (Vec3, bool, f64) {
+fn tet_average(parts: &Particles, c: Pt3, rad: f64, half_h: f64, ids: &[u32], omega_valid: f64) -> TetP2g {
     let (mut sw, mut sv) = (0.0, Vec3::zeros());
     for &i in ids {
         let i = i as usize;
@@ -447,10 +450,10 @@ mod tests {
             let got = particles_to_tets(&m, &h, &parts, &tp);
             let occ = crate::surface::SphereTree::build(&parts.x, &vec![0.0; parts.len()]);
             let mut buf = Vec::new();
-            for t in 0..m.tets.len() {
-                let (c, rad) = (m.centroid[t], support * h[t]);
+            for (t, &ht) in h.iter().enumerate() {
+                let (c, rad) = (m.centroid[t], support * ht);
                 occ.within(&c, rad, &mut buf);
-                let want = tet_average(&parts, c, rad, 0.5 * h[t], &buf, tp.omega_valid);
+                let want = tet_average(&parts, c, rad, 0.5 * ht, &buf, tp.omega_valid);
                 assert_eq!(got.u[t], want.0, "tet {t}");
                 assert_eq!(got.valid[t], want.1);
                 assert_eq!(got.coverage[t].to_bits(), want.2.to_bits());
