@@ -286,8 +286,10 @@ mod tests {
     fn damping_ratio_of_a_damped_cosine() {
         let (zeta, w) = (0.05f64, 5.0f64);
         let wd = w * (1.0 - zeta * zeta).sqrt();
-        let s: Vec<(f64, f64)> =
-            (0..4000).map(|i| i as f64 * 0.002).map(|t| (t, 0.3 + 0.02 * (-zeta * w * t).exp() * (wd * t).cos())).collect();
+        let s: Vec<(f64, f64)> = (0..4000)
+            .map(|i| i as f64 * 0.002)
+            .map(|t| (t, 0.3 + 0.02 * (-zeta * w * t).exp() * (wd * t).cos()))
+            .collect();
         let z = damping_ratio(&s, 0.0).unwrap();
         assert!((z - zeta).abs() < 2e-3, "{z}");
         let u: Vec<(f64, f64)> = (0..4000).map(|i| i as f64 * 0.002).map(|t| (t, 0.3 + 0.02 * (w * t).cos())).collect();

@@ -175,6 +175,12 @@ pub struct ParticleParams {
     pub budget_is_error: bool,
     /// Standing-wave sampling: in each column the top particle is placed at `η(x) − r`.
     pub column_top_on_surface: bool,
+    /// Shift of the initial particle lattice, per axis, in units of the particle spacing `2r`
+    /// (spec §6 S1b: `(0, 0.37, 0)` moves a flat pool surface strictly between BCC node planes).
+    /// Which lattice points are kept, and their `φ_p`, are decided at the unshifted point, so the
+    /// whole sampled liquid is translated by `offset · 2r` (the shape's surface moves with it;
+    /// a translation keeps every signed distance). Default `[0, 0, 0]`: the unshifted lattice.
+    pub lattice_offset: [f64; 3],
 }
 
 impl Default for ParticleParams {
@@ -193,6 +199,7 @@ impl Default for ParticleParams {
             max_particles: 5_000_000,
             budget_is_error: false,
             column_top_on_surface: false,
+            lattice_offset: [0.0; 3],
         }
     }
 }
@@ -389,6 +396,9 @@ impl Scene {
         }
         if !(q.sampling_jitter.is_finite() && (0.0..0.5).contains(&q.sampling_jitter)) {
             return bad("particles.sampling_jitter must lie in [0, 0.5)");
+        }
+        if !q.lattice_offset.iter().all(|v| v.is_finite() && v.abs() < 1.0) {
+            return bad("particles.lattice_offset components must be finite and lie in (−1, 1)");
         }
         let t = &self.transfer;
         if !(t.support > 0.0 && t.omega_valid > 0.0 && t.omega_blend >= t.omega_valid) {

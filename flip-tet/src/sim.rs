@@ -170,10 +170,12 @@ fn face_index(f: BoxFace) -> usize {
 }
 
 /// Samples every leaf inside the liquid with 2×2×2 particles of radius `h_leaf/4` at the sub-cube
-/// centres (spec S1a), jittered by `jitter · 2r`; optional standing-wave column stretching.
+/// centres (spec S1a), jittered by `jitter · 2r`, shifted by `lattice_offset · 2r` (spec S1b);
+/// optional standing-wave column stretching.
 fn sample_particles(scene: &Scene, oct: &Octree, rng: &mut Rng) -> Particles {
     let mut p = Particles::default();
     let jit = scene.particles.sampling_jitter;
+    let off = Vec3::from(scene.particles.lattice_offset);
     for lf in &oct.leaves {
         let h = oct.spec.h(lf.level);
         let o = oct.spec.position(&lf.origin.0);
@@ -188,8 +190,11 @@ fn sample_particles(scene: &Scene, oct: &Octree, rng: &mut Rng) -> Particles {
                 x += Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * (jit * r);
             }
             let d = scene.liquid_sdf(&x);
-            if d < 0.0 && scene.solid_sdf(&x) > r {
-                p.push(x, scene.velocity_at(&x), r, scene.initial_phi(&x));
+            // The shift (zero by default: `x + 0 = x` bitwise for every non-(−0) coordinate) moves
+            // the kept particle; membership, velocity and φ_p are those of the unshifted point.
+            let xs = x + off * (2.0 * r);
+            if d < 0.0 && scene.solid_sdf(&xs) > r {
+                p.push(xs, scene.velocity_at(&x), r, scene.initial_phi(&x));
             }
         }
     }
@@ -382,7 +387,13 @@ impl FlipTetSim {
                 };
                 let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
                 ctx.surface = curv.as_ref();
-                let demands = Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx), None);
+                let solid = |x: &Pt3| scene.solid_sdf(x);
+                if !scene.obstacles.is_empty() {
+                    ctx.solid_sdf = Some(&solid);
+                }
+                let mut demands =
+                    Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx), None);
+                demands.extend(Self::obstacle_demands(scene, &spec, &sizing, &ctx));
                 let mut next = build_octree(spec, &demands);
                 if scene.extra_grading_layers > 0 {
                     balance_2to1(&mut next, scene.extra_grading_layers);
@@ -480,6 +491,36 @@ impl FlipTetSim {
                 let h = spec.h(level);
                 let pad = (2.0 * h).max(f64::from(scene.flip.remesh_interval) * dt * parts.v[i].norm());
                 SizeDemand { center: parts.x[i], pad, level }
+            })
+            .collect()
+    }
+
+    /// Obstacle-metric demands (spec §3.12: "obstacle metrics add demands sampled on a coarse
+    /// grid of points"): the obstacle metrics ([`Sizing::obstacle_radius_at`], e.g. the solid
+    /// curvature) evaluated at the centres of the finest cubes of the whole domain, so the mesh is
+    /// graded around the obstacles (hole rims, S7) whether or not liquid is there yet. Each
+    /// finite demand covers its sample cell: pad `2 h + (√3/2) h_min` for its level's edge `h`.
+    /// Empty (no cost) unless an obstacle metric is on and the scene has obstacles.
+    fn obstacle_demands(scene: &Scene, spec: &OctreeSpec, sizing: &Sizing, ctx: &SizingContext) -> Vec<SizeDemand> {
+        if !sizing.has_obstacle_metric() || scene.obstacles.is_empty() || ctx.solid_sdf.is_none() {
+            return Vec::new();
+        }
+        let (r_min, r_max) = (spec.h_min() / C_H, spec.h_root / C_H);
+        let h_min = spec.h_min();
+        let ext = scene.max() - scene.min();
+        let n = [0, 1, 2].map(|a| (ext[a] / h_min).round().max(1.0) as usize);
+        let cover = 0.5 * 3f64.sqrt() * h_min;
+        (0..n[0] * n[1] * n[2])
+            .into_par_iter()
+            .filter_map(|k| {
+                let (i, j, l) = (k % n[0], (k / n[0]) % n[1], k / (n[0] * n[1]));
+                let x = scene.min() + Vec3::new(i as f64 + 0.5, j as f64 + 0.5, l as f64 + 0.5) * h_min;
+                let r = sizing.obstacle_radius_at(&x, ctx);
+                if !r.is_finite() {
+                    return None;
+                }
+                let level = spec.level_for_size(C_H * r.clamp(r_min, r_max));
+                (level > 0).then(|| SizeDemand { center: x, pad: 2.0 * spec.h(level) + cover, level })
             })
             .collect()
     }
@@ -636,7 +677,7 @@ impl FlipTetSim {
         if !self.scene.obstacles.is_empty() {
             ctx.solid_sdf = Some(&solid);
         }
-        let demands = Self::demands_static(
+        let mut demands = Self::demands_static(
             &self.scene,
             &self.spec,
             &self.sizing,
@@ -645,6 +686,7 @@ impl FlipTetSim {
             Some(&ctx),
             Some(&self.octree),
         );
+        demands.extend(Self::obstacle_demands(&self.scene, &self.spec, &self.sizing, &ctx));
         let mut oct = build_octree(self.spec, &demands);
         if self.scene.extra_grading_layers > 0 {
             balance_2to1(&mut oct, self.scene.extra_grading_layers);
@@ -1057,6 +1099,17 @@ impl FlipTetSim {
         crate::surface::marching_tets(&self.mesh, &self.phi).ok()
     }
 
+    /// High-resolution output surface for rendering (spec §3.11.6, see
+    /// [`crate::surface::output_surface`]): a separate tet mesh `surface.output_extra_levels`
+    /// levels finer than the simulation's around the surface and the spray (ballistic particles
+    /// included), the same hull level set with the same wall mirroring, marching tetrahedra and
+    /// Taubin smoothing. Obstacles are not carved out (the surface may continue inside them,
+    /// where a renderer hides it). Costly: scenes ask for it per frame (`hires_every`).
+    pub fn output_surface(&self) -> Result<crate::surface::OutputSurface> {
+        let walls = Walls { min: self.scene.min(), max: self.scene.max(), mirror: self.walls(), node_in_solid: None };
+        crate::surface::output_surface(&self.spec, &self.parts, &self.scene.surface, &walls)
+    }
+
     /// Grid velocity of the last step at `x` (m/s): the sub-tet interpolation (spec §3.7) of the
     /// post-projection tet velocities and their nodal averages; `None` outside the mesh or before
     /// the first step.
@@ -1341,5 +1394,35 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// S1b lattice offset: with `lattice_offset = (0.1, 0.37, −0.2)` the seeding keeps the same
+    /// lattice points as without it (same count, radii, velocities, `φ_p` bitwise) and moves each
+    /// by exactly `offset · 2r`; the default (zero) offset gives the unshifted lattice; offsets
+    /// outside (−1, 1) are rejected by `validate`.
+    #[test]
+    fn lattice_offset_translates_the_seeded_lattice() {
+        let text = r#"(domain: (min: (0.0, 0.0, 0.0), max: (1.0, 0.5, 0.5)),
+            resolution: (coarsest: 8, finest: 8), duration: 0.1,
+            liquid: [Box(min: (0.0, 0.0, 0.0), max: (1.0, 0.25, 0.5))])"#;
+        let base: Scene = ron::from_str(text).expect("test scene parses");
+        let oct = Octree::uniform(OctreeSpec::new(base.min(), base.max(), 8, 8).unwrap(), 0);
+        let a = sample_particles(&base, &oct, &mut Rng::new(1));
+        // 8 × 2 × 4 cubes of h = 1/8 below y = 0.25, 8 particles each.
+        assert_eq!(a.len(), 8 * 2 * 4 * 8);
+        let top = a.x.iter().map(|x| x.y).fold(f64::MIN, f64::max);
+        assert_eq!(top, 0.25 - 1.0 / 32.0);
+        let mut shifted = base.clone();
+        shifted.particles.lattice_offset = [0.1, 0.37, -0.2];
+        shifted.validate().expect("offset inside (−1, 1) is valid");
+        let b = sample_particles(&shifted, &oct, &mut Rng::new(1));
+        assert_eq!(b.len(), a.len());
+        let off = Vec3::new(0.1, 0.37, -0.2);
+        for i in 0..a.len() {
+            assert_eq!(b.x[i], a.x[i] + off * (2.0 * a.r[i]), "particle {i}");
+            assert_eq!((b.r[i], b.phi[i], b.v[i]), (a.r[i], a.phi[i], a.v[i]));
+        }
+        shifted.particles.lattice_offset = [0.0, 1.5, 0.0];
+        assert!(shifted.validate().is_err());
     }
 }

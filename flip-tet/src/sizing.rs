@@ -140,6 +140,13 @@ pub trait SizingMetric: Sync + Send {
     fn radius_at(&self, x: &Pt3, ctx: &SizingContext) -> f64;
     /// Short name (for statistics and plots).
     fn name(&self) -> &'static str;
+    /// Whether the metric describes the obstacles (a function of position alone): such metrics
+    /// are also sampled on a grid over the domain (spec §3.12: "obstacle metrics add demands
+    /// sampled on a coarse grid of points"), so the mesh is graded around obstacles before the
+    /// liquid reaches them. Default `false`.
+    fn is_obstacle_metric(&self) -> bool {
+        false
+    }
 }
 
 /// The combined sizing function of a scene (spec §2, §3.12).
@@ -184,6 +191,22 @@ impl Sizing {
             metrics.push(Box::new(UserBoxes { boxes: b.clone() }));
         }
         Ok(Self { metrics, visibility: p.visibility.clone(), depth_floor: p.depth_floor, surface_band: p.surface_band })
+    }
+
+    /// Whether an obstacle metric ([`SizingMetric::is_obstacle_metric`]) is on.
+    pub fn has_obstacle_metric(&self) -> bool {
+        self.metrics.iter().any(|m| m.is_obstacle_metric())
+    }
+
+    /// The smallest radius the obstacle metrics ask for at `x` (m), `+∞` when none has an opinion
+    /// (neither the depth floor, the band nor the visibility apply: they describe the liquid and
+    /// the camera, not the obstacle).
+    pub fn obstacle_radius_at(&self, x: &Pt3, ctx: &SizingContext) -> f64 {
+        self.metrics
+            .iter()
+            .filter(|m| m.is_obstacle_metric())
+            .map(|m| m.radius_at(x, ctx))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Whether any term needs the level set (depth floor or surface band).

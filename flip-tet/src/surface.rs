@@ -9,6 +9,7 @@
 mod extract;
 mod hull;
 mod levelset;
+mod output;
 mod spheretree;
 #[cfg(test)]
 pub(crate) mod test_mesh;
@@ -22,6 +23,7 @@ pub use levelset::{
     extend_into_solids, level_set_on_nodes, level_set_on_nodes_sign_inside, node_edges, node_sizes,
     redistance_interior, LevelSetSampler, Walls,
 };
+pub use output::{output_surface, OutputSurface};
 pub use spheretree::SphereTree;
 pub(crate) use volume::tet_volume;
 pub use volume::{liquid_volume, tet_liquid_volume};

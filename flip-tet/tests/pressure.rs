@@ -152,6 +152,35 @@ fn pcg_agrees_with_direct() {
     }
 }
 
+/// MIC(0)-PCG factors in the lattice-key order of the DOFs (`PressureSystem::mic_order`): on a
+/// uniform 24 × 24 × 12 tank (≈ 3.3 k DOFs, planar surface off the node planes, second-order
+/// ghosts) it solves to the direct solution (1e−6 of its max at tol 1e−10) and needs at most half
+/// the CG iterations of the same preconditioner in the node order (the assembly's, leaf centres
+/// first: almost a two-colouring of the BCC graph, which weakens incomplete factorisations).
+/// Measured: 32 vs 150 iterations.
+#[test]
+fn mic_in_lattice_order_converges_faster_to_the_same_solution() {
+    let (oct, m) = uniform(24);
+    let phi: Vec<f64> = m.nodes.iter().map(|p| p.y - 0.7 - 0.013).collect();
+    let ustar: Vec<Vec3> = m.centroid.iter().map(|c| Vec3::new((3.0 * c.z).sin(), -1.0, c.x * c.y)).collect();
+    let mut p = PressureParams::default();
+    let sys = assemble_pressure(&m, &phi, &ustar, oct.spec.h_min(), &p);
+    assert!(sys.rhs.len() > 2000, "{} DOFs", sys.rhs.len());
+    let (qd, _) = PressureSolver::default().solve(&sys, &p, None).unwrap();
+    p.solver = flip_tet::error::SolverKind::PcgIc0;
+    p.tol = 1e-10;
+    let (q_lat, r_lat) = PressureSolver::default().solve(&sys, &p, None).unwrap();
+    let mut node_order = sys.clone();
+    node_order.mic_order.clear();
+    let (q_node, r_node) = PressureSolver::default().solve(&node_order, &p, None).unwrap();
+    let scale = qd.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for ((a, b), c) in qd.iter().zip(&q_lat).zip(&q_node) {
+        assert!((a - b).abs() <= 1e-6 * scale && (a - c).abs() <= 1e-6 * scale);
+    }
+    eprintln!("MIC(0)-PCG iterations: lattice order {}, node order {}", r_lat.iters, r_node.iters);
+    assert!(2 * r_lat.iters <= r_node.iters, "lattice {} vs node {}", r_lat.iters, r_node.iters);
+}
+
 /// T-K-RULE, continuity (finite differences): the blend `k_t` of spec §3.5 is continuous in φ
 /// away from the classification changes (a node crossing φ = 0, a ghost entering a fallback).
 /// On the depth-graded mesh with off-centre spheres crossing the level transitions, every tet

@@ -68,7 +68,7 @@ fn dam_break_full(scene: &Scene, dir: &Path) -> Result<DamRun> {
     };
     let g = -scene.gravity[1];
     let mut front = Vec::new();
-    let (stats, wall, _) = simulate(scene, dir, FrameOutput { obj: 0, ply: 0 }, &mut |sim, st| {
+    let (stats, wall, _) = simulate(scene, dir, FrameOutput::NONE, &mut |sim, st| {
         front.push((st.t * (2.0 * g / a).sqrt(), metrics::front_position(sim.particles(), scene.domain.min[0]) / a));
     })?;
     let (_, rms) = front_errors(&front);
@@ -83,7 +83,7 @@ fn vol_drift(stats: &[flip_tet::sim::StepStats]) -> f64 {
 }
 
 fn rest(scene: &Scene, dir: &Path) -> Result<(f64, f64, f64, usize)> {
-    let (stats, wall, _) = simulate(scene, dir, FrameOutput { obj: 0, ply: 0 }, &mut |_, _| {})?;
+    let (stats, wall, _) = simulate(scene, dir, FrameOutput::NONE, &mut |_, _| {})?;
     let vmax = stats.iter().map(|x| x.max_speed).fold(0.0, f64::max);
     Ok((vmax, vol_drift(&stats), wall, stats.len()))
 }
@@ -110,7 +110,7 @@ fn wave_full(scene: &Scene, dir: &Path) -> Result<WaveRun> {
     let t_th = 2.0 * std::f64::consts::PI / (g * k * (k * (mean - scene.domain.min[1])).tanh()).sqrt();
     let zc = 0.5 * (scene.domain.min[2] + scene.domain.max[2]);
     let mut eta = Vec::new();
-    let (stats, wall, _) = simulate(scene, dir, FrameOutput { obj: 0, ply: 0 }, &mut |sim, st| {
+    let (stats, wall, _) = simulate(scene, dir, FrameOutput::NONE, &mut |sim, st| {
         if let Some(h) = metrics::surface_height(sim, scene.domain.min[0] + sim.spec().h_min() / 2.0, zc) {
             eta.push((st.t, h));
         }
@@ -292,12 +292,8 @@ fn sweep_solver(c: &Ctx, o: &mut Out, out_dir: &Path) -> Result<()> {
             s.duration = 40.0 * s.flip.dt_max;
             s.pressure.solver = kind;
             s.pressure.tol = 1e-6;
-            let (stats, wall, _) = simulate(
-                &s,
-                &c.tmp.join(format!("solver_{name}_{n}")),
-                FrameOutput { obj: 0, ply: 0 },
-                &mut |_, _| {},
-            )?;
+            let (stats, wall, _) =
+                simulate(&s, &c.tmp.join(format!("solver_{name}_{n}")), FrameOutput::NONE, &mut |_, _| {})?;
             let k = stats.len().max(1) as f64;
             let dofs = stats.iter().map(|x| x.n_dofs as f64).sum::<f64>() / k;
             let ms = 1e3 * stats.iter().map(|x| x.timings.solve).sum::<f64>() / k;
@@ -371,8 +367,7 @@ fn sweep_pic(c: &Ctx, o: &mut Out, out_dir: &Path) -> Result<()> {
         let mut p = pool0.clone();
         set(&mut p);
         p.particles.sampling_jitter = 0.1;
-        let (stats, wall, _) =
-            simulate(&p, &c.tmp.join(format!("pic_rest_{pic}")), FrameOutput { obj: 0, ply: 0 }, &mut |_, _| {})?;
+        let (stats, wall, _) = simulate(&p, &c.tmp.join(format!("pic_rest_{pic}")), FrameOutput::NONE, &mut |_, _| {})?;
         let tail = &stats[stats.len() - (stats.len() / 10).max(1)..];
         let noise = tail.iter().map(|x| x.max_speed).fold(0.0, f64::max);
         o.row("pic", &pic.to_string(), wall, stats.len(), 0.0, "rest_jitter_late_max_speed", noise);
@@ -401,8 +396,7 @@ fn sweep_surface(c: &Ctx, o: &mut Out, out_dir: &Path) -> Result<()> {
         s.surface.method = m;
         s.particles.sampling_jitter = 0.1;
         s.duration = 200.0 * s.flip.dt_max;
-        let (stats, wall, _) =
-            simulate(&s, &c.tmp.join(format!("surface_{name}")), FrameOutput { obj: 0, ply: 0 }, &mut |_, _| {})?;
+        let (stats, wall, _) = simulate(&s, &c.tmp.join(format!("surface_{name}")), FrameOutput::NONE, &mut |_, _| {})?;
         let ke = stats.last().map_or(f64::NAN, |x| x.kinetic_energy);
         o.row("surface", name, wall, stats.len(), 0.0, "rest_jitter_final_ke_J", ke);
         o.summary.set(&format!("rest_jitter_final_ke_J_{name}"), ke);

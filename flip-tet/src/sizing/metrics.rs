@@ -89,6 +89,9 @@ impl SizingMetric for SolidCurvature {
     fn name(&self) -> &'static str {
         "solid_curvature"
     }
+    fn is_obstacle_metric(&self) -> bool {
+        true
+    }
 }
 
 /// Vorticity floor `ε` of the turbulence metric (1/s).

@@ -14,6 +14,7 @@ use geom_core::io::{write_obj_frame, MeshOut};
 use serde::Deserialize;
 
 use super::flip_tet_snapshots::Snapshots;
+use super::flip_tet_variants::{rest_pool_variants, rest_run, standing_wave_variants, wave_run};
 use crate::error::{Error, Result};
 use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
@@ -26,7 +27,7 @@ pub fn register(v: &mut Vec<Runner>) {
     v.push(Runner { method: "flip-tet/dam-break", run: run_dam_break });
     v.push(Runner { method: "flip-tet/standing-wave", run: run_standing_wave });
     v.push(Runner { method: "flip-tet/drop-pool", run: run_drop_pool });
-    v.push(Runner { method: "flip-tet/holes-plate", run: run_drop_pool });
+    v.push(Runner { method: "flip-tet/holes-plate", run: super::flip_tet_holes::run_holes_plate });
     v.push(Runner { method: "flip-tet/adaptivity-payoff", run: run_adaptivity });
 }
 
@@ -55,9 +56,22 @@ pub struct FtParams {
     /// `particles_ply`).
     #[serde(default)]
     pub ply_every: u64,
+    /// Write the high-resolution output surface (spec §3.11.6: a separate mesh
+    /// `surface.output_extra_levels` finer around the surface and the spray) as OBJ every
+    /// `hires_every` frames into `frames_hires/` (0 = never, the default: it costs a fine mesh and
+    /// a level set per written frame, ≈ 0.8 s at dam-break default).
+    #[serde(default)]
+    pub hires_every: u64,
     /// adaptivity-payoff: finest resolutions compared for (quick, default, full).
     #[serde(default)]
     pub sizes: Option<(Vec<u32>, Vec<u32>, Vec<u32>)>,
+    /// rest-pool / standing-wave: the extra runs of spec §6 S1 / S3 (all off when absent).
+    #[serde(default)]
+    pub variants: super::flip_tet_variants::Variants,
+    /// holes-plate (spec S7): also run the uniform finest mesh and compare the volume passed
+    /// through the plate, per mode (quick, default, full); the spec asks for it in full mode only.
+    #[serde(default)]
+    pub uniform_comparison: Option<(bool, bool, bool)>,
 }
 
 fn one() -> u64 {
@@ -103,6 +117,16 @@ pub(crate) fn simulate(
         if every.ply > 0 && frame.is_multiple_of(every.ply) {
             write_particles_ply(&out.join("particles"), frame, sim)?;
         }
+        if every.hires > 0 && frame.is_multiple_of(every.hires) {
+            let o = ft(sim.output_surface())?;
+            if o.mesh.n_faces() > 0 {
+                write_obj_frame(
+                    &out.join("frames_hires"),
+                    (frame / every.hires) as usize,
+                    &MeshOut::from_tri_mesh(&o.mesh),
+                )?;
+            }
+        }
         snaps.frame(sim, frame)
     };
     write_frame(&sim, 0)?;
@@ -121,17 +145,28 @@ pub(crate) fn simulate(
     Ok((all, wall, sim))
 }
 
-/// Which frames of a run are written: the surface as OBJ every `obj` frames, the particles as
-/// PLY every `ply` frames (0 = never).
+/// Which frames of a run are written: the simulation surface as OBJ every `obj` frames, the
+/// particles as PLY every `ply` frames, the high-resolution output surface (spec §3.11.6) as OBJ
+/// every `hires` frames (0 = never).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct FrameOutput {
     pub obj: u64,
     pub ply: u64,
+    pub hires: u64,
 }
 
 impl FrameOutput {
-    fn of(p: &FtParams) -> Self {
-        Self { obj: p.obj_every, ply: p.ply_every }
+    /// Nothing written (benchmarks, comparison runs).
+    pub(crate) const NONE: Self = Self { obj: 0, ply: 0, hires: 0 };
+
+    /// Only the simulation surface, every `obj` frames.
+    pub(crate) fn surface(obj: u64) -> Self {
+        Self { obj, ..Self::NONE }
+    }
+
+    /// What the scene file asks for.
+    pub(crate) fn of(p: &FtParams) -> Self {
+        Self { obj: p.obj_every, ply: p.ply_every, hires: p.hires_every }
     }
 }
 
@@ -177,34 +212,36 @@ fn common(s: &mut Summary, stats: &[StepStats], wall: f64) {
     s.set_str("profile", if cfg!(debug_assertions) { "debug" } else { "release" });
 }
 
-fn rel_drift(stats: &[StepStats], f: impl Fn(&StepStats) -> f64) -> f64 {
+pub(crate) fn rel_drift(stats: &[StepStats], f: impl Fn(&StepStats) -> f64) -> f64 {
     let Some(first) = stats.first() else { return 0.0 };
     let v0 = f(first);
     stats.iter().map(|x| (f(x) - v0).abs()).fold(0.0, f64::max) / v0.abs().max(1e-300)
 }
 
+/// S1 (spec §6): S1a, the adaptive lattice pool (second order, the scene's solver), in `out_dir`;
+/// then the variants the scene file switches on (`flip_tet_variants`), each in its sub-folder.
 fn run_rest_pool(ctx: &RunCtx) -> Result<Summary> {
     let (p, scene) = load(ctx)?;
-    let x0 = ft(FlipTetSim::new(&scene))?.particles().x.clone();
-    let mut disp: f64 = 0.0;
-    let (stats, wall, _) = simulate(&scene, &ctx.out_dir, FrameOutput::of(&p), &mut |sim, _| {
-        if sim.particles().len() == x0.len() {
-            let d = sim.particles().x.iter().zip(&x0).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
-            disp = disp.max(d);
-        }
-    })?;
+    let r = rest_run(&scene, &ctx.out_dir, FrameOutput::of(&p), None)?;
     let mut s = Summary::new();
-    s.set("max_speed", stats.iter().map(|x| x.max_speed).fold(0.0, f64::max));
-    s.set("volume_drift_rel", rel_drift(&stats, |x| x.vol_levelset));
-    s.set("particle_volume_drift_rel", rel_drift(&stats, |x| x.vol_particles));
-    s.set("max_displacement", disp);
-    s.set_count("splits_merges", stats.iter().map(|x| (x.n_split + x.n_merge) as u64).sum());
-    common(&mut s, &stats, wall);
-    let pts: Vec<(f64, f64)> = stats.iter().map(|x| (x.step as f64, x.max_speed.max(1e-20))).collect();
-    LinePlot::new("rest pool: max particle speed", "step", "max speed (m/s)")
+    s.set("max_speed", r.max_speed());
+    s.set("volume_drift_rel", rel_drift(&r.stats, |x| x.vol_levelset));
+    s.set("particle_volume_drift_rel", rel_drift(&r.stats, |x| x.vol_particles));
+    s.set("max_displacement", r.max_disp);
+    s.set_count("splits_merges", r.stats.iter().map(|x| (x.n_split + x.n_merge) as u64).sum());
+    common(&mut s, &r.stats, r.wall);
+    let mut plot = LinePlot::new("rest pool: max particle speed", "step", "max speed (m/s)")
         .log(false, true)
-        .with(Series::new("second order, direct", pts))
-        .write_png(&ctx.out_dir.join("speed_vs_step.png"))?;
+        .with(Series::new("second order, direct", r.speed_series()));
+    // Plot S1a now (a long variant run that stops still leaves it), again with the variants.
+    plot.write_png(&ctx.out_dir.join("speed_vs_step.png"))?;
+    let extra = rest_pool_variants(ctx, &p, &scene, &mut s)?;
+    if !extra.is_empty() {
+        for e in extra {
+            plot = plot.with(e);
+        }
+        plot.write_png(&ctx.out_dir.join("speed_vs_step.png"))?;
+    }
     Ok(s)
 }
 
@@ -295,41 +332,30 @@ pub(crate) fn front_errors(front: &[(f64, f64)]) -> (Vec<f64>, f64) {
     (errs, rms)
 }
 
+/// S3 (spec §6): the depth-graded second-order wave in `out_dir`, period and damping ratio vs
+/// linear theory; then the variants the scene file switches on (`flip_tet_variants`).
 fn run_standing_wave(ctx: &RunCtx) -> Result<Summary> {
     let (p, scene) = load(ctx)?;
-    let (mean, amp, len, x0) = match scene.liquid.first() {
-        Some(Shape::CosineSurface { mean, amplitude, length, x0 }) => (*mean, *amplitude, *length, *x0),
-        _ => return Err(Error::Run("standing-wave: the liquid must be a CosineSurface".into())),
-    };
-    let depth = mean - scene.domain.min[1];
-    let g = -scene.gravity[1];
-    let k = std::f64::consts::PI / len;
-    let omega = (g * k * (k * depth).tanh()).sqrt();
-    let t_th = 2.0 * std::f64::consts::PI / omega;
-    let zc = 0.5 * (scene.domain.min[2] + scene.domain.max[2]);
-    let mut eta: Vec<(f64, f64)> = Vec::new();
-    let mut xp = x0;
-    let (stats, wall, _) = simulate(&scene, &ctx.out_dir, FrameOutput::of(&p), &mut |sim, st| {
-        xp = x0 + sim.spec().h_min() / 2.0;
-        if let Some(h) = metrics::surface_height(sim, xp, zc) {
-            eta.push((st.t, h));
-        }
-    })?;
-    let period = metrics::zero_crossing_period(&eta, 0.5 * t_th);
+    let r = wave_run(&scene, &ctx.out_dir, FrameOutput::of(&p))?;
     let mut s = Summary::new();
-    s.set("period_theory_s", t_th);
-    s.set("period_sim_s", period.unwrap_or(f64::NAN));
-    s.set("period_rel_err", period.map_or(f64::NAN, |p| (p - t_th).abs() / t_th));
-    s.set("amplitude_initial_m", amp);
-    let theory: Vec<(f64, f64)> = eta
-        .iter()
-        .map(|&(t, _)| (t, mean + amp * (std::f64::consts::PI * (xp - x0) / len).cos() * (omega * t).cos()))
-        .collect();
-    common(&mut s, &stats, wall);
-    LinePlot::new("standing wave: surface height at the wall", "t (s)", "eta (m)")
-        .with(Series::new("simulation", eta))
-        .with(Series::new("linear theory", theory))
-        .write_png(&ctx.out_dir.join("eta_vs_time.png"))?;
+    s.set("period_theory_s", r.th.period);
+    s.set("period_sim_s", r.period.unwrap_or(f64::NAN));
+    s.set("period_rel_err", r.period_rel_err());
+    s.set("amplitude_initial_m", r.th.amp);
+    s.set("damping_ratio", r.damping.unwrap_or(f64::NAN));
+    s.set("volume_drift_rel", rel_drift(&r.stats, |x| x.vol_levelset));
+    common(&mut s, &r.stats, r.wall);
+    let mut plot = LinePlot::new("standing wave: surface height at the wall", "t (s)", "eta (m)")
+        .with(Series::new("simulation", r.eta.clone()))
+        .with(Series::new("linear theory", r.theory_series()));
+    plot.write_png(&ctx.out_dir.join("eta_vs_time.png"))?;
+    let extra = standing_wave_variants(ctx, &p, &scene, &r, &mut s)?;
+    if !extra.is_empty() {
+        for e in extra {
+            plot = plot.with(e);
+        }
+        plot.write_png(&ctx.out_dir.join("eta_vs_time.png"))?;
+    }
     Ok(s)
 }
 
@@ -359,12 +385,19 @@ fn initial_liquid_volume(scene: &Scene, n: usize) -> f64 {
 fn run_drop_pool(ctx: &RunCtx) -> Result<Summary> {
     let (p, scene) = load(ctx)?;
     let (stats, wall, _) = simulate(&scene, &ctx.out_dir, FrameOutput::of(&p), &mut |_, _| {})?;
+    drop_pool_summary(&scene, &stats, wall, &ctx.out_dir)
+}
+
+/// The drop-pool figures of a finished run (spec S4; also S7's): particle counts against the
+/// uniform estimate, the ballistic fraction, the Pearson correlation of step time (remesh
+/// excluded) with the particle count, the level-set volume drift, and `particles_vs_time.png`.
+pub(crate) fn drop_pool_summary(scene: &Scene, stats: &[StepStats], wall: f64, out_dir: &Path) -> Result<Summary> {
     let n0 = stats.first().map_or(0, |x| x.n_particles) as f64;
     let peak = stats.iter().map(|x| x.n_particles).max().unwrap_or(0) as f64;
     let end = stats.last().map_or(0, |x| x.n_particles) as f64;
     let h_min = (0..3).map(|a| scene.domain.max[a] - scene.domain.min[a]).fold(0.0, f64::max)
         / f64::from(scene.resolution.finest);
-    let uniform = 8.0 * initial_liquid_volume(&scene, 128) / h_min.powi(3);
+    let uniform = 8.0 * initial_liquid_volume(scene, 128) / h_min.powi(3);
     let ballistic: f64 = stats.iter().map(|x| x.n_ballistic as f64 / x.n_particles.max(1) as f64).sum::<f64>()
         / stats.len().max(1) as f64;
     // Pearson correlation of per-step wall time (remesh excluded) with particle count.
@@ -384,12 +417,12 @@ fn run_drop_pool(ctx: &RunCtx) -> Result<Summary> {
     s.set("uniform_over_adaptive_initial", uniform / n0.max(1.0));
     s.set("ballistic_fraction_avg", ballistic);
     s.set("time_particles_pearson", if vx > 0.0 && vy > 0.0 { cov / (vx * vy).sqrt() } else { f64::NAN });
-    s.set("vol_levelset_drift_rel", rel_drift(&stats, |x| x.vol_levelset));
-    common(&mut s, &stats, wall);
+    s.set("vol_levelset_drift_rel", rel_drift(stats, |x| x.vol_levelset));
+    common(&mut s, stats, wall);
     let pts: Vec<(f64, f64)> = stats.iter().map(|x| (x.t, x.n_particles as f64)).collect();
     LinePlot::new("particles vs time", "t (s)", "particles")
         .with(Series::new("adaptive", pts))
-        .write_png(&ctx.out_dir.join("particles_vs_time.png"))?;
+        .write_png(&out_dir.join("particles_vs_time.png"))?;
     Ok(s)
 }
 
@@ -414,7 +447,7 @@ fn run_adaptivity(ctx: &RunCtx) -> Result<Summary> {
             }
             let dir = ctx.out_dir.join(format!("{}_{n}", if adaptive { "adaptive" } else { "uniform" }));
             crate::out::ensure_dir(&dir)?;
-            let (stats, wall, _) = simulate(&sc, &dir, FrameOutput { obj: 0, ply: 0 }, &mut |_, _| {})?;
+            let (stats, wall, _) = simulate(&sc, &dir, FrameOutput::NONE, &mut |_, _| {})?;
             let ps: f64 = stats.iter().map(|x| x.n_particles as f64).sum();
             let avg = ps / stats.len().max(1) as f64;
             csv.row(&[
@@ -481,7 +514,8 @@ mod tests {
         let scene: Scene = ron::from_str(text).expect("scene");
         let dir = std::env::temp_dir().join(format!("ft-ply-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("dir");
-        let (_, _, sim) = simulate(&scene, &dir, FrameOutput { obj: 0, ply: 1 }, &mut |_, _| {}).expect("short run");
+        let (_, _, sim) =
+            simulate(&scene, &dir, FrameOutput { ply: 1, ..FrameOutput::NONE }, &mut |_, _| {}).expect("short run");
         for f in 0..=2 {
             assert!(dir.join(format!("particles/particles_{f:04}.ply")).is_file(), "frame {f}");
         }
@@ -492,6 +526,25 @@ mod tests {
         assert_eq!(back.prop("phi").expect("phi"), p.phi.as_slice());
         let vy: Vec<f64> = p.v.iter().map(|v| v.y).collect();
         assert_eq!(back.prop("velocity_y").expect("velocity_y"), vy.as_slice());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// `hires_every: 2` writes the output surface of frames 0 and 2 into `frames_hires/` (OBJ
+    /// 0000 and 0001), each with more triangles than the simulation surface of the same frame.
+    #[test]
+    fn hires_frames_are_written_and_finer() {
+        let text = r#"(domain: (min: (0.0, 0.0, 0.0), max: (0.5, 0.5, 0.5)),
+            resolution: (coarsest: 4, finest: 8), duration: 0.05, fps: 40.0,
+            liquid: [Box(min: (0.0, 0.0, 0.0), max: (0.25, 0.25, 0.5))])"#;
+        let scene: Scene = ron::from_str(text).expect("scene");
+        let dir = std::env::temp_dir().join(format!("ft-hires-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        simulate(&scene, &dir, FrameOutput { obj: 2, ply: 0, hires: 2 }, &mut |_, _| {}).expect("short run");
+        for f in 0..=1 {
+            let sim = geom_core::io::obj::read(dir.join(format!("frames/{f:04}.obj"))).expect("simulation frame");
+            let hi = geom_core::io::obj::read(dir.join(format!("frames_hires/{f:04}.obj"))).expect("hires frame");
+            assert!(hi.faces.len() > sim.faces.len(), "frame {f}: {} vs {}", hi.faces.len(), sim.faces.len());
+        }
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
