@@ -386,9 +386,10 @@ impl Scene {
             && p.tol.is_finite()
             && p.ghost_tolerance >= 0.0
             && p.min_interface_fraction > 0.0
-            && p.min_interface_fraction < 1.0)
+            && p.min_interface_fraction < 1.0
+            && (0.0..0.5).contains(&p.surface_snap))
         {
-            return bad("pressure: tol > 0, ghost_tolerance ≥ 0, 0 < min_interface_fraction < 1 required");
+            return bad("pressure: tol > 0, ghost_tolerance ≥ 0, 0 < min_interface_fraction < 1, 0 ≤ surface_snap < 0.5 required");
         }
         let q = &self.particles;
         if !(q.ballistic_factor > 0.0 && q.split_ratio > 1.0 && q.merge_ratio < 1.0 && q.merge_ratio > 0.0) {

@@ -133,7 +133,8 @@ fn raw_fraction(mesh: &TetMesh, phi: &[f64], g: &flip_tet::pressure::Ghost) -> f
 
 /// H-TINY-FRACTION: the planar surface `y = 0.5 + ε` lies just above the corner-node plane
 /// `y = 0.5`, whose nodes are liquid with `φ = −ε` (`ε` from 1e−4 h down to 1e−8 h, above the
-/// 1e−9 h snap). Interface fractions below `λ_min = 0.01` are clamped, so every ghost scale
+/// spec's 1e−9 h snap, `surface_snap: 1e-9`: the default 0.01 h would snap them onto the
+/// surface). Interface fractions below `λ_min = 0.01` are clamped, so every ghost scale
 /// satisfies `|k s| ≤ 99`; the condition number is bounded by `κ(A) ≤ κ(A₁)/λ_min = 100 κ(A₁)`
 /// (`A₁` the first-order matrix: the ghost terms are positive semidefinite, so `λ_min(A) ≥
 /// λ_min(A₁)`, and on regular tets they add at most `99 |c_i| ≤ 99 K^t_ii` to each row, so
@@ -145,7 +146,7 @@ fn h_tiny_fraction_clamp_bounds_scale_condition_and_cg_converges() {
     let (oct, mesh) = uniform4();
     let h = oct.spec.h_min();
     let ustar: Vec<Vec3> = mesh.centroid.iter().map(|c| Vec3::new(0.3 * c.z, -0.08, 0.2 * c.x)).collect();
-    let p = PressureParams::default();
+    let p = PressureParams { surface_snap: 1e-9, ..PressureParams::default() };
     let cond = |sys: &PressureSystem| {
         let (lo, hi) = eig_range(&sys.matrix);
         assert!(lo > 0.0, "smallest eigenvalue {lo}");
