@@ -29,16 +29,17 @@ use std::time::Duration;
 
 use criterion::measurement::WallTime;
 use criterion::{BatchSize, BenchmarkGroup, Criterion, SamplingMode, Throughput};
+use flip_tet::advect::{advect, g2p, AdvectMesh, TetField};
 use flip_tet::bcc::{tetrahedralize, TetMesh};
 use flip_tet::error::SolverKind;
 use flip_tet::octree::{build_octree, Octree, OctreeSpec, SizeDemand};
-use flip_tet::particles::{apply_walls, ParticleFlags, Particles};
+use flip_tet::particles::{apply_walls, Particles};
 use flip_tet::pressure::{assemble_pressure, PressureParams, PressureSolver, PressureSystem};
 use flip_tet::scene::Scene;
 use flip_tet::sim::FlipTetSim;
 use flip_tet::sizing::{Sizing, SizingContext, C_H};
 use flip_tet::surface::{level_set_on_nodes_sign_inside, marching_tets, LevelSetSampler, Walls};
-use flip_tet::transfer::{extrapolate, node_average, particles_to_tets, pic_fraction, sample};
+use flip_tet::transfer::{extrapolate, node_average, particles_to_tets};
 use geom_core::math::{Pt3, Vec3};
 use geom_core::rng::Rng;
 use geom_core::NONE;
@@ -325,61 +326,20 @@ fn bench_p2g(c: &mut Criterion, fx: &DamBreak) {
     g.finish();
 }
 
-/// G2P and advection of one step, as `FlipTetSim::step` stages 9–10 do them (the library has no
-/// public entry point for either): per particle the PIC/FLIP blend of the sub-tet interpolated
+/// G2P and advection of one step with the simulator's own kernels (`flip_tet::advect::{g2p,
+/// advect}`, `FlipTetSim::step` stages 9–10): the PIC/FLIP blend of the sub-tet interpolated
 /// `u_new` and `Δu` (spec §3.7), then RK2 through the time-centred field `(1 − s) u_old + s u_new`
 /// with CFL substeps `ceil(|v| Δt / (h/2))` and a tet walk per velocity sample (spec §3.8), box
 /// walls, and the final relocation walk. Ballistic particles fly free. Returns the substeps
 /// beyond one.
 fn g2p_advect(fx: &DamBreak, parts: &mut Particles) -> u32 {
-    let (mesh, oct, fp) = (&fx.mesh, &fx.octree, &fx.scene.flip);
+    let (mesh, oct) = (&fx.mesh, &fx.octree);
     let r_min = oct.spec.h_min() / C_H;
-    let g = fx.scene.g();
-    let (xs, vs, rs, ts, fl) = (&mut parts.x, &mut parts.v, &parts.r, &mut parts.tet, &parts.flags);
-    vs.par_iter_mut().enumerate().for_each(|(i, v)| {
-        if fl[i].has(ParticleFlags::BALLISTIC) || ts[i] == NONE {
-            return;
-        }
-        let l = mesh.barycentric(ts[i], &xs[i]);
-        let a = pic_fraction(rs[i], r_min, fp.pic_base, fp.pic_radius_exponent, fp.pic_floor);
-        let vn = sample(mesh, &fx.u_new, &fx.nodal_new, ts[i], &l);
-        let dv = sample(mesh, &fx.du, &fx.nodal_du, ts[i], &l);
-        *v = vn * a + (*v + dv) * (1.0 - a);
-    });
-    let vel = |p: &Pt3, hint: u32, s: f64| -> (Vec3, u32) {
-        match mesh.walk(oct, hint, p) {
-            Some((tt, l)) => {
-                let un = sample(mesh, &fx.u_new, &fx.nodal_new, tt, &l);
-                let uo = sample(mesh, &fx.u_old, &fx.nodal_old, tt, &l);
-                (un * s + uo * (1.0 - s), tt)
-            }
-            None => (Vec3::zeros(), hint),
-        }
-    };
-    let subs: u32 = xs
-        .par_iter_mut()
-        .zip(vs.par_iter_mut())
-        .zip(ts.par_iter_mut())
-        .enumerate()
-        .map(|(i, ((x, v), t))| {
-            if fl[i].has(ParticleFlags::BALLISTIC) || *t == NONE {
-                *v += g * DT;
-                *x += *v * DT;
-                return 0;
-            }
-            let n = ((v.norm() * DT) / (0.5 * fx.h_tet[*t as usize])).ceil().clamp(1.0, 64.0) as u32;
-            let sdt = DT / f64::from(n);
-            for k in 0..n {
-                let s0 = f64::from(k) / f64::from(n);
-                let (v1, t1) = vel(x, *t, s0);
-                let mid = *x + v1 * (0.5 * sdt);
-                let (v2, t2) = vel(&mid, t1, s0 + 0.5 / f64::from(n));
-                *x += v2 * sdt;
-                *t = t2;
-            }
-            n - 1
-        })
-        .sum();
+    let new = TetField { tet: &fx.u_new, nodal: &fx.nodal_new };
+    g2p(mesh, parts, new, TetField { tet: &fx.du, nodal: &fx.nodal_du }, r_min, &fx.scene.flip);
+    let grid = AdvectMesh { mesh, octree: oct, h_tet: &fx.h_tet };
+    let old = TetField { tet: &fx.u_old, nodal: &fx.nodal_old };
+    let subs: u32 = advect(&grid, parts, new, Some(old), fx.scene.g(), DT).iter().sum();
     apply_walls(parts, &fx.scene.min(), &fx.scene.max(), &[false; 6]);
     parts.tet.par_iter_mut().zip(parts.x.par_iter()).for_each(|(t, x)| {
         *t = mesh.walk(oct, *t, x).map_or(NONE, |(tt, _)| tt);

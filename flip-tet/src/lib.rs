@@ -3,6 +3,7 @@
 //!
 //! See `README.md` and `shared/specs/flip-tet.md` for the method and the module map (spec §2).
 
+pub mod advect;
 pub mod bcc;
 pub mod error;
 #[cfg(feature = "fvm-baseline")]

@@ -11,6 +11,7 @@ use geom_core::spatial::KdTree;
 use geom_core::NONE;
 use rayon::prelude::*;
 
+use crate::advect::{advect, g2p, AdvectMesh, TetField};
 use crate::bcc::{tetrahedralize, TetMesh};
 use crate::error::{Result, SimError};
 use crate::octree::{balance_2to1, build_octree, Octree, OctreeSpec, SizeDemand};
@@ -21,7 +22,7 @@ use crate::pressure::{apply_pressure, assemble_pressure, PressureSolver, SolveRe
 use crate::scene::{BoxFace, DtPolicy, Scene, Shape};
 use crate::sizing::{Sizing, SizingContext, SurfaceCurvature, C_H};
 use crate::surface::{level_set_on_nodes, level_set_on_nodes_sign_inside, liquid_volume, tet_liquid_volume, Walls};
-use crate::transfer::{blend_weak, extrapolate, node_average, particles_to_tets, pic_fraction, sample};
+use crate::transfer::{blend_weak, extrapolate, node_average, particles_to_tets, sample};
 
 /// Liquid density used for the energies (kg/m³).
 pub const RHO: f64 = 1000.0;
@@ -923,79 +924,17 @@ impl FlipTetSim {
         tm.extrapolate += c.elapsed().as_secs_f64();
         // 9. G2P.
         let c = Instant::now();
-        let fp = &self.scene.flip;
         let r_min = self.spec.h_min() / C_H;
-        {
-            let mesh = &self.mesh;
-            let (u_r, nn, du_r, nd) = (&u, &nodal_new, &du, &nodal_du);
-            let parts = &mut self.parts;
-            let (xs, vs, rs, ts, fl) = (&parts.x, &mut parts.v, &parts.r, &parts.tet, &parts.flags);
-            vs.par_iter_mut().enumerate().for_each(|(i, v)| {
-                if fl[i].has(ParticleFlags::BALLISTIC) || ts[i] == NONE {
-                    return;
-                }
-                let l = mesh.barycentric(ts[i], &xs[i]);
-                let a = pic_fraction(rs[i], r_min, fp.pic_base, fp.pic_radius_exponent, fp.pic_floor);
-                let vn = sample(mesh, u_r, nn, ts[i], &l);
-                let dv = sample(mesh, du_r, nd, ts[i], &l);
-                *v = vn * a + (*v + dv) * (1.0 - a);
-            });
-        }
+        let new_field = TetField { tet: &u, nodal: &nodal_new };
+        g2p(&self.mesh, &mut self.parts, new_field, TetField { tet: &du, nodal: &nodal_du }, r_min, &self.scene.flip);
         tm.g2p = c.elapsed().as_secs_f64();
         // 10. Advection (RK2 with substeps), ballistic free flight, walls, obstacles.
         let c = Instant::now();
         // Time-centred advection (ours, see README "Deviations"): the old field's nodal averages.
         let nodal_old = self.scene.flip.time_centred_advection.then(|| node_average(&self.mesh, &u_old, wall_mask));
-        let subs: Vec<u32> = {
-            let mesh = &self.mesh;
-            let oct = &self.octree;
-            let h_tet = &self.h_tet;
-            let (u_r, nn) = (&u, &nodal_new);
-            let old_fields: Option<(&[Vec3], &[Vec3])> = nodal_old.as_deref().map(|no| (u_old.as_slice(), no));
-            let parts = &mut self.parts;
-            let (xs, vs, rs, ts, fl) = (&mut parts.x, &mut parts.v, &parts.r, &mut parts.tet, &parts.flags);
-            xs.par_iter_mut()
-                .zip(vs.par_iter_mut())
-                .zip(ts.par_iter_mut())
-                .enumerate()
-                .map(|(i, ((x, v), t))| {
-                    let _ = rs;
-                    if fl[i].has(ParticleFlags::BALLISTIC) || *t == NONE {
-                        *v += g * dt;
-                        *x += *v * dt;
-                        return 0;
-                    }
-                    let h = h_tet[*t as usize];
-                    let n = ((v.norm() * dt) / (0.5 * h)).ceil().clamp(1.0, 64.0) as u32;
-                    let sdt = dt / f64::from(n);
-                    // Velocity at fraction `s` of the step: `u_new`, or with time-centred
-                    // advection the linear-in-time field `(1 − s) u_old + s u_new`.
-                    let vel = |p: &Pt3, hint: u32, s: f64| -> (Vec3, u32) {
-                        match mesh.walk(oct, hint, p) {
-                            Some((tt, l)) => {
-                                let un = sample(mesh, u_r, nn, tt, &l);
-                                match old_fields {
-                                    Some((uo, no)) if s < 1.0 => {
-                                        (un * s + sample(mesh, uo, no, tt, &l) * (1.0 - s), tt)
-                                    }
-                                    _ => (un, tt),
-                                }
-                            }
-                            None => (Vec3::zeros(), hint),
-                        }
-                    };
-                    for k in 0..n {
-                        let s0 = f64::from(k) / f64::from(n);
-                        let (v1, t1) = vel(x, *t, s0);
-                        let mid = *x + v1 * (0.5 * sdt);
-                        let (v2, t2) = vel(&mid, t1, s0 + 0.5 / f64::from(n));
-                        *x += v2 * sdt;
-                        *t = t2;
-                    }
-                    n - 1
-                })
-                .collect()
-        };
+        let old_field = nodal_old.as_deref().map(|no| TetField { tet: &u_old, nodal: no });
+        let grid = AdvectMesh { mesh: &self.mesh, octree: &self.octree, h_tet: &self.h_tet };
+        let subs = advect(&grid, &mut self.parts, new_field, old_field, g, dt);
         st.cfl_substeps = subs.iter().sum();
         let keep = apply_walls(&mut self.parts, &self.scene.min(), &self.scene.max(), &self.open);
         if !self.scene.obstacles.is_empty() {
