@@ -564,7 +564,13 @@ impl PressureSolver {
 /// tolerance; only the preconditioner (and hence the iterates) depend on the order.
 fn mic_pcg(sys: &PressureSystem, p: &PressureParams, warm: Option<&[f64]>) -> Result<(Vec<f64>, SolveReport)> {
     let nd = sys.rhs.len();
-    let order: Vec<u32> = if sys.mic_order.len() == nd { sys.mic_order.clone() } else { (0..nd as u32).collect() };
+    let identity: Vec<u32>;
+    let order: &[u32] = if sys.mic_order.len() == nd {
+        &sys.mic_order
+    } else {
+        identity = (0..nd as u32).collect();
+        &identity
+    };
     let mut new_of = vec![0u32; nd];
     for (k, &d) in order.iter().enumerate() {
         new_of[d as usize] = k as u32;

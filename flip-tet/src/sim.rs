@@ -135,6 +135,9 @@ pub struct FlipTetSim {
     scene: Scene,
     spec: OctreeSpec,
     sizing: Sizing,
+    /// The obstacle-metric demands ([`Self::obstacle_demands`]): the obstacles are static and
+    /// those metrics read only the solid SDF and the level sizes, so they are sampled once.
+    obstacle_demands: Vec<SizeDemand>,
     octree: Octree,
     mesh: TetMesh,
     h_tet: Vec<f64>,
@@ -367,6 +370,14 @@ impl FlipTetSim {
         for f in &scene.open_faces {
             open[face_index(*f)] = true;
         }
+        let obstacle_demands = {
+            let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
+            let solid = |x: &Pt3| scene.solid_sdf(x);
+            if !scene.obstacles.is_empty() {
+                ctx.solid_sdf = Some(&solid);
+            }
+            Self::obstacle_demands(scene, &spec, &sizing, &ctx)
+        };
         let mut octree = Octree::uniform(spec, 0);
         let mut parts = sample_particles(scene, &octree, &mut rng.clone());
         if spec.levels > 1 {
@@ -394,7 +405,7 @@ impl FlipTetSim {
                 }
                 let mut demands =
                     Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx), None);
-                demands.extend(Self::obstacle_demands(scene, &spec, &sizing, &ctx));
+                demands.extend_from_slice(&obstacle_demands);
                 let mut next = build_octree(spec, &demands);
                 if scene.extra_grading_layers > 0 {
                     balance_2to1(&mut next, scene.extra_grading_layers);
@@ -413,6 +424,7 @@ impl FlipTetSim {
             scene: scene.clone(),
             spec,
             sizing,
+            obstacle_demands,
             octree: octree.clone(),
             mesh: TetMesh::default(),
             h_tet: Vec::new(),
@@ -687,7 +699,7 @@ impl FlipTetSim {
             Some(&ctx),
             Some(&self.octree),
         );
-        demands.extend(Self::obstacle_demands(&self.scene, &self.spec, &self.sizing, &ctx));
+        demands.extend_from_slice(&self.obstacle_demands);
         let mut oct = build_octree(self.spec, &demands);
         if self.scene.extra_grading_layers > 0 {
             balance_2to1(&mut oct, self.scene.extra_grading_layers);
