@@ -17,9 +17,8 @@
 //! serial in the library (octree build, assembly, marching tets, the direct solve with
 //! `faer::Par::Seq`) are measured with `t1` only: a second thread cannot change them.
 //!
-//! Not measured: `split_merge` (spec §9 lists it) is the private `FlipTetSim::split_merge`, and
-//! `FlipTetSim` cannot be cloned to reset its state between iterations. `g2p_advect` has no
-//! public entry point either; [`g2p_advect`] repeats the simulator's loop with public pieces.
+//! `split_merge` runs the simulator's own pass ([`flip_tet::split_merge::split_merge`]) on a copy
+//! of the particles; [`g2p_advect`] calls the simulator's G2P and advection kernels.
 //!
 //! Run: `cargo bench -p flip-tet --bench micro` (≈ 4 min of measurement on the project's 2-core
 //! machine); filter with a substring, e.g. `-- solve_mic`.
@@ -35,9 +34,10 @@ use flip_tet::error::SolverKind;
 use flip_tet::octree::{build_octree, Octree, OctreeSpec, SizeDemand};
 use flip_tet::particles::{apply_walls, Particles};
 use flip_tet::pressure::{assemble_pressure, PressureParams, PressureSolver, PressureSystem};
-use flip_tet::scene::Scene;
+use flip_tet::scene::{Scene, TimeIntegration};
 use flip_tet::sim::FlipTetSim;
 use flip_tet::sizing::{Sizing, SizingContext, C_H};
+use flip_tet::split_merge::{split_merge, OldLevelSet};
 use flip_tet::surface::{level_set_on_nodes_sign_inside, marching_tets, LevelSetSampler, Walls};
 use flip_tet::transfer::{extrapolate, node_average, particles_to_tets};
 use geom_core::math::{Pt3, Vec3};
@@ -281,6 +281,49 @@ fn bench_octree_build(c: &mut Criterion, fx: &DamBreak) {
     g.finish();
 }
 
+/// The dam-break demands with every level shifted by `shift` (clamped to the spec's levels):
+/// `+1` asks for cubes half the size everywhere (splits), `−1` for twice the size (merges).
+fn shifted_demands(fx: &DamBreak, shift: i32) -> Vec<SizeDemand> {
+    let top = i32::from(fx.octree.spec.levels) - 1;
+    fx.demands.iter().map(|d| SizeDemand { level: (i32::from(d.level) + shift).clamp(0, top) as u8, ..*d }).collect()
+}
+
+/// `split_merge`: [`split_merge`] (split passes, merge passes with a k-d tree of the particles,
+/// surface snap against the old level set; serial, `t1` only) of the dam-break particles against
+/// three new octrees: `remesh` (the octree of the current demands, what the next remesh builds:
+/// few changes), `refine` (every demand one level finer: splits) and `coarsen` (one level
+/// coarser: merges). The particle copy is made outside the timed routine. Throughput: particles
+/// in, i.e. particles/s.
+fn bench_split_merge(c: &mut Criterion, fx: &DamBreak) {
+    let spec = fx.octree.spec;
+    let old = OldLevelSet { mesh: &fx.mesh, octree: &fx.octree, phi: &fx.phi };
+    let pp = &fx.scene.particles;
+    let cases = [("remesh", 0), ("refine", 1), ("coarsen", -1)];
+    let mut g = group(c, "split_merge", 20, 3.0);
+    g.throughput(Throughput::Elements(fx.parts.len() as u64));
+    for (name, shift) in cases {
+        let oct = build_octree(spec, &shifted_demands(fx, shift));
+        // Invariant: the bench scene's particle budget is the default (far above these counts).
+        let counts = split_merge(&mut fx.parts.clone(), &oct, pp, &mut Rng::new(1), &old).expect("within budget");
+        eprintln!(
+            "split_merge {name}: {} particles, {} splits, {} merges",
+            fx.parts.len(),
+            counts.split,
+            counts.merged
+        );
+        g.bench_function(format!("dam64_{name}/t1"), |b| {
+            pool(1).install(|| {
+                b.iter_batched_ref(
+                    || (fx.parts.clone(), Rng::new(1)),
+                    |(p, rng)| black_box(split_merge(p, &oct, pp, rng, &old).expect("within budget")),
+                    BatchSize::LargeInput,
+                )
+            })
+        });
+    }
+    g.finish();
+}
+
 /// `tetrahedralize`: graded BCC tetrahedralisation of the dam-break octree including
 /// `compute_geometry` (volumes, gradients, face neighbours, node rings; the per-tet and per-node
 /// parts run in parallel). Throughput: tets, i.e. tets/s.
@@ -328,9 +371,10 @@ fn bench_p2g(c: &mut Criterion, fx: &DamBreak) {
 
 /// G2P and advection of one step with the simulator's own kernels (`flip_tet::advect::{g2p,
 /// advect}`, `FlipTetSim::step` stages 9–10): the PIC/FLIP blend of the sub-tet interpolated
-/// `u_new` and `Δu` (spec §3.7), then RK2 through the time-centred field `(1 − s) u_old + s u_new`
-/// with CFL substeps `ceil(|v| Δt / (h/2))` and a tet walk per velocity sample (spec §3.8), box
-/// walls, and the final relocation walk. Ballistic particles fly free. Returns the substeps
+/// `u_new` and `Δu` (spec §3.7), then RK2 through `u_new` (the default leapfrog drift; the
+/// time-centred field `(1 − s) u_old + s u_new` when the scene asks for `TimeCentred`) with CFL
+/// substeps `ceil(|v| Δt / (h/2))` and a tet walk per velocity sample (spec §3.8), box walls, and
+/// the final relocation walk. Ballistic particles fly free (kick `g Δt`). Returns the substeps
 /// beyond one.
 fn g2p_advect(fx: &DamBreak, parts: &mut Particles) -> u32 {
     let (mesh, oct) = (&fx.mesh, &fx.octree);
@@ -338,8 +382,9 @@ fn g2p_advect(fx: &DamBreak, parts: &mut Particles) -> u32 {
     let new = TetField { tet: &fx.u_new, nodal: &fx.nodal_new };
     g2p(mesh, parts, new, TetField { tet: &fx.du, nodal: &fx.nodal_du }, r_min, &fx.scene.flip);
     let grid = AdvectMesh { mesh, octree: oct, h_tet: &fx.h_tet };
-    let old = TetField { tet: &fx.u_old, nodal: &fx.nodal_old };
-    let subs: u32 = advect(&grid, parts, new, Some(old), fx.scene.g(), DT).iter().sum();
+    let centred = fx.scene.flip.time_integration == TimeIntegration::TimeCentred;
+    let old = centred.then_some(TetField { tet: &fx.u_old, nodal: &fx.nodal_old });
+    let subs: u32 = advect(&grid, parts, new, old, fx.scene.g() * DT, DT).iter().sum();
     apply_walls(parts, &fx.scene.min(), &fx.scene.max(), &[false; 6]);
     parts.tet.par_iter_mut().zip(parts.x.par_iter()).for_each(|(t, x)| {
         *t = mesh.walk(oct, *t, x).map_or(NONE, |(tt, _)| tt);
@@ -458,11 +503,20 @@ fn bench_solves(c: &mut Criterion, sel: &Selection) {
 fn main() {
     let mut c = Criterion::default().configure_from_args();
     let sel = Selection::from_args();
-    let dam_groups =
-        ["octree_build", "tetrahedralize", "assemble", "p2g", "g2p_advect", "hull_levelset", "marching_tets"];
+    let dam_groups = [
+        "octree_build",
+        "split_merge",
+        "tetrahedralize",
+        "assemble",
+        "p2g",
+        "g2p_advect",
+        "hull_levelset",
+        "marching_tets",
+    ];
     if dam_groups.iter().any(|g| sel.wants(g, "dam64")) {
         let fx = &build_dam_break();
         bench_octree_build(&mut c, fx);
+        bench_split_merge(&mut c, fx);
         bench_tetrahedralize(&mut c, fx);
         bench_assemble(&mut c, fx);
         bench_p2g(&mut c, fx);

@@ -61,14 +61,15 @@ pub fn g2p(mesh: &TetMesh, parts: &mut Particles, new: TetField, du: TetField, r
 /// grid velocity in `n = ceil(|v| Δt / (h_t / 2))` substeps (1 … 64), walking its tet with every
 /// velocity sample; the velocity at fraction `s` of the step is `new`, or with `old` (time-centred
 /// advection) the linear-in-time field `(1 − s) old + s new`. Ballistic and unlocated particles fly
-/// free under gravity `g` (m/s²). Walls, obstacles and relocation are the caller's. Returns the
-/// substeps beyond one per particle.
+/// free: their velocity takes the gravity `kick` of the step (m/s, `g Δt_kick`, see
+/// [`crate::scene::TimeIntegration`]), then they move by `v Δt`. Walls, obstacles and relocation
+/// are the caller's. Returns the substeps beyond one per particle.
 pub fn advect(
     m: &AdvectMesh,
     parts: &mut Particles,
     new: TetField,
     old: Option<TetField>,
-    g: Vec3,
+    kick: Vec3,
     dt: f64,
 ) -> Vec<u32> {
     let (mesh, oct, h_tet) = (m.mesh, m.octree, m.h_tet);
@@ -79,7 +80,7 @@ pub fn advect(
         .enumerate()
         .map(|(i, ((x, v), t))| {
             if fl[i].has(ParticleFlags::BALLISTIC) || *t == NONE {
-                *v += g * dt;
+                *v += kick;
                 *x += *v * dt;
                 return 0;
             }

@@ -384,6 +384,20 @@ impl TetMesh {
         [0.25 + g[0].dot(&d), 0.25 + g[1].dot(&d), 0.25 + g[2].dot(&d), 0.25 + g[3].dot(&d)]
     }
 
+    /// The nodal field `f` interpolated linearly (P1) in tet `t` at `x`.
+    pub fn interpolate(&self, t: u32, x: &Pt3, f: &[f64]) -> f64 {
+        let l = self.barycentric(t, x);
+        let tv = self.tets[t as usize];
+        (0..4).map(|a| l[a] * f[tv[a] as usize]).sum()
+    }
+
+    /// Gradient of the P1 interpolant of the nodal field `f` in tet `t` (constant per tet).
+    pub fn gradient(&self, t: u32, f: &[f64]) -> Vec3 {
+        let tv = self.tets[t as usize];
+        let g = &self.grad_bary[t as usize];
+        (0..4).fold(Vec3::zeros(), |acc, a| acc + g[a] * f[tv[a] as usize])
+    }
+
     /// Point location (spec §3.2): the leaf containing `x`, then the tets around the leaf centre;
     /// the first with all `λ ≥ −1e−12`, else the one with the largest minimum barycentric.
     /// Points outside the box are clamped to it. Returns `None` only for an empty mesh.

@@ -16,5 +16,6 @@ pub mod pressure;
 pub mod scene;
 pub mod sim;
 pub mod sizing;
+pub mod split_merge;
 pub mod surface;
 pub mod transfer;

@@ -7,7 +7,6 @@ use std::time::Instant;
 use geom_core::math::{Pt3, Vec3};
 use geom_core::mesh::TriMesh;
 use geom_core::rng::Rng;
-use geom_core::spatial::KdTree;
 use geom_core::NONE;
 use rayon::prelude::*;
 
@@ -15,12 +14,11 @@ use crate::advect::{advect, g2p, AdvectMesh, TetField};
 use crate::bcc::{tetrahedralize, TetMesh};
 use crate::error::{Result, SimError};
 use crate::octree::{balance_2to1, build_octree, Octree, OctreeSpec, SizeDemand};
-use crate::particles::{
-    apply_obstacles, apply_walls, classify_ballistic, position_correction, ParticleFlags, Particles,
-};
+use crate::particles::{apply_obstacles, apply_walls, classify_ballistic, position_correction, Particles};
 use crate::pressure::{apply_pressure, assemble_pressure, PressureSolver, SolveReport, W_MIN};
-use crate::scene::{BoxFace, DtPolicy, Scene, Shape};
+use crate::scene::{BoxFace, DtPolicy, Scene, Shape, TimeIntegration};
 use crate::sizing::{Sizing, SizingContext, SurfaceCurvature, C_H};
+use crate::split_merge::{split_merge, OldLevelSet};
 use crate::surface::{level_set_on_nodes, level_set_on_nodes_sign_inside, liquid_volume, tet_liquid_volume, Walls};
 use crate::transfer::{blend_weak, extrapolate, node_average, particles_to_tets, sample};
 
@@ -160,6 +158,9 @@ pub struct FlipTetSim {
     pub deleted_volume: f64,
     /// Particle budget hit at the last remesh.
     pub budget_hit: bool,
+    /// Length of the previous step (s; 0 before the first): the leapfrog kick spans
+    /// `(prev_dt + Δt) / 2`.
+    prev_dt: f64,
 }
 
 fn face_index(f: BoxFace) -> usize {
@@ -443,6 +444,7 @@ impl FlipTetSim {
             h_ref,
             deleted_volume: 0.0,
             budget_hit: false,
+            prev_dt: 0.0,
         };
         sim.set_mesh(octree)?;
         sim.relocate();
@@ -580,19 +582,7 @@ impl FlipTetSim {
         });
     }
 
-    /// Linear interpolation of the node level set at `x` in tet `t`.
-    fn phi_in(&self, t: u32, x: &Pt3) -> f64 {
-        let l = self.mesh.barycentric(t, x);
-        let tv = self.mesh.tets[t as usize];
-        (0..4).map(|a| l[a] * self.phi[tv[a] as usize]).sum()
-    }
-
-    fn phi_grad(&self, t: u32) -> Vec3 {
-        let tv = self.mesh.tets[t as usize];
-        let g = &self.mesh.grad_bary[t as usize];
-        (0..4).fold(Vec3::zeros(), |acc, a| acc + g[a] * self.phi[tv[a] as usize])
-    }
-
+    /// Stores each located particle's interpolated level set `φ_p` (0 for unlocated ones).
     fn store_particle_phi(&mut self) {
         let vals: Vec<f64> = (0..self.parts.len())
             .into_par_iter()
@@ -601,7 +591,7 @@ impl FlipTetSim {
                 if t == NONE {
                     0.0
                 } else {
-                    self.phi_in(t, &self.parts.x[i])
+                    self.mesh.interpolate(t, &self.parts.x[i], &self.phi)
                 }
             })
             .collect();
@@ -715,107 +705,21 @@ impl FlipTetSim {
         self.relocate();
     }
 
-    /// Split and merge against the new octree's leaf sizes (spec §3.10). Conserves `Σ r³` and
-    /// `Σ r³ v` exactly (before the surface snap).
+    /// Split and merge against the new octree's leaf sizes (spec §3.10, [`crate::split_merge`]),
+    /// the surface snap reading the old mesh's `φ`.
     fn split_merge(&mut self, new_oct: &Octree) -> Result<(usize, usize)> {
-        let pp = self.scene.particles.clone();
-        let target: Vec<f64> = self.parts.x.iter().map(|x| new_oct.leaf_h(new_oct.leaf_at(x)) / C_H).collect();
-        let mut n_split = 0;
-        // Split passes.
-        for _ in 0..9 {
-            let n0 = self.parts.len();
-            let mut any = false;
-            for i in 0..n0 {
-                if self.parts.is_ballistic(i) {
-                    continue;
-                }
-                let tr = new_oct.leaf_h(new_oct.leaf_at(&self.parts.x[i])) / C_H;
-                if self.parts.r[i] > pp.split_ratio * tr {
-                    if self.parts.len() >= pp.max_particles {
-                        self.budget_hit = true;
-                        if pp.budget_is_error {
-                            return Err(SimError::ParticleBudgetExceeded { limit: pp.max_particles });
-                        }
-                        break;
-                    }
-                    let r = self.parts.r[i];
-                    let rc = r / 2f64.cbrt();
-                    let off = self.rng.unit_vec3() * (0.5 * r * self.rng.f64());
-                    let x = self.parts.x[i];
-                    self.parts.x[i] = x + off;
-                    self.parts.r[i] = rc;
-                    let (v, phi) = (self.parts.v[i], self.parts.phi[i]);
-                    self.parts.push(x - off, v, rc, phi);
-                    let last = self.parts.len() - 1;
-                    self.parts.flags[last].0 |= ParticleFlags::NEW_THIS_REMESH;
-                    self.parts.flags[i].0 |= ParticleFlags::NEW_THIS_REMESH;
-                    self.parts.tet[last] = self.parts.tet[i];
-                    n_split += 1;
-                    any = true;
-                }
+        let old = OldLevelSet { mesh: &self.mesh, octree: &self.octree, phi: &self.phi };
+        let pp = &self.scene.particles;
+        match split_merge(&mut self.parts, new_oct, pp, &mut self.rng, &old) {
+            Ok(c) => {
+                self.budget_hit = c.budget_hit;
+                Ok((c.split, c.merged))
             }
-            if !any {
-                break;
+            Err(e) => {
+                self.budget_hit = matches!(e, SimError::ParticleBudgetExceeded { .. });
+                Err(e)
             }
         }
-        let _ = target;
-        // Merge passes: nearest untouched non-ballistic neighbour that also wants to merge.
-        let mut n_merge = 0;
-        for _ in 0..9 {
-            let tree = KdTree::build(&self.parts.x);
-            let n = self.parts.len();
-            let mut touched = vec![false; n];
-            let mut keep = vec![true; n];
-            let mut any = false;
-            let mut buf = Vec::new();
-            for i in 0..n {
-                if touched[i] || self.parts.is_ballistic(i) {
-                    continue;
-                }
-                let tr = new_oct.leaf_h(new_oct.leaf_at(&self.parts.x[i])) / C_H;
-                if self.parts.r[i] >= pp.merge_ratio * tr {
-                    continue;
-                }
-                tree.knn(&self.parts.x[i], 8, &mut buf);
-                let j = buf
-                    .iter()
-                    .map(|&(j, _)| j as usize)
-                    .find(|&j| j != i && !touched[j] && !self.parts.is_ballistic(j));
-                let Some(j) = j else { continue };
-                let (vi, vj) = (self.parts.r[i].powi(3), self.parts.r[j].powi(3));
-                let w = vi + vj;
-                self.parts.x[i] = Pt3::from((self.parts.x[i].coords * vi + self.parts.x[j].coords * vj) / w);
-                self.parts.v[i] = (self.parts.v[i] * vi + self.parts.v[j] * vj) / w;
-                self.parts.phi[i] = (self.parts.phi[i] * vi + self.parts.phi[j] * vj) / w;
-                self.parts.r[i] = w.cbrt();
-                self.parts.flags[i].0 |= ParticleFlags::NEW_THIS_REMESH;
-                touched[i] = true;
-                touched[j] = true;
-                keep[j] = false;
-                n_merge += 1;
-                any = true;
-            }
-            self.parts.retain(&keep);
-            if !any {
-                break;
-            }
-        }
-        // Surface snap of new particles (old mesh φ): −snap r < φ < 0 ⇒ tangent to the interface.
-        for i in 0..self.parts.len() {
-            if !self.parts.flags[i].has(ParticleFlags::NEW_THIS_REMESH) {
-                continue;
-            }
-            if let Some((t, _)) = self.mesh.walk(&self.octree, self.parts.tet[i], &self.parts.x[i]) {
-                let phi = self.phi_in(t, &self.parts.x[i]);
-                let r = self.parts.r[i];
-                let g = self.phi_grad(t);
-                if phi < 0.0 && phi > -pp.snap_factor * r && g.norm() > 0.0 {
-                    let n = g / g.norm();
-                    self.parts.x[i] -= n * (phi + r);
-                }
-            }
-        }
-        Ok((n_split, n_merge))
     }
 
     /// One adaptive time step (spec §3.1).
@@ -873,7 +777,13 @@ impl FlipTetSim {
         }
         tm.extrapolate = c.elapsed().as_secs_f64();
         // 6. Forces.
-        let mut u = u_old.iter().map(|v| v + g * dt).collect::<Vec<_>>();
+        // Kick length: leapfrog velocities live at half steps (README "Deviations").
+        let ti = self.scene.flip.time_integration;
+        let dt_kick = match ti {
+            TimeIntegration::Leapfrog => 0.5 * (self.prev_dt + dt),
+            TimeIntegration::TimeCentred | TimeIntegration::EndOfStep => dt,
+        };
+        let mut u = u_old.iter().map(|v| v + g * dt_kick).collect::<Vec<_>>();
         // 7. Pressure projection.
         let c = Instant::now();
         // Open box faces are free surfaces for the pressure (p = 0 there), so liquid can leave.
@@ -943,10 +853,10 @@ impl FlipTetSim {
         // 10. Advection (RK2 with substeps), ballistic free flight, walls, obstacles.
         let c = Instant::now();
         // Time-centred advection (ours, see README "Deviations"): the old field's nodal averages.
-        let nodal_old = self.scene.flip.time_centred_advection.then(|| node_average(&self.mesh, &u_old, wall_mask));
+        let nodal_old = (ti == TimeIntegration::TimeCentred).then(|| node_average(&self.mesh, &u_old, wall_mask));
         let old_field = nodal_old.as_deref().map(|no| TetField { tet: &u_old, nodal: no });
         let grid = AdvectMesh { mesh: &self.mesh, octree: &self.octree, h_tet: &self.h_tet };
-        let subs = advect(&grid, &mut self.parts, new_field, old_field, g, dt);
+        let subs = advect(&grid, &mut self.parts, new_field, old_field, g * dt_kick, dt);
         st.cfl_substeps = subs.iter().sum();
         let keep = apply_walls(&mut self.parts, &self.scene.min(), &self.scene.max(), &self.open);
         if !self.scene.obstacles.is_empty() {
@@ -1006,6 +916,7 @@ impl FlipTetSim {
         // Statistics.
         self.time += dt;
         self.step += 1;
+        self.prev_dt = dt;
         let next = (self.frame + 1) as f64 / self.scene.fps;
         if self.time >= next - 1e-9 * dt.max(1e-12) {
             self.frame += 1;

@@ -147,9 +147,10 @@ fn h_all_ballistic_spray_falls_freely_on_the_coarsest_mesh() {
         assert_eq!(sim.mesh().tets.len(), coarsest_tets, "step {n}: the mesh stays coarsest");
         let nf = f64::from(n);
         for (p, (x, v)) in x0.iter().zip(&v0).enumerate() {
-            // Semi-implicit Euler of free fall: v_n = v₀ + n g Δt, x_n = x₀ + n v₀ Δt + n(n+1)/2 g Δt².
-            let want_v = v + g * (nf * dt);
-            let want_x = x + v * (nf * dt) + g * (dt * dt * nf * (nf + 1.0) / 2.0);
+            // Leapfrog free fall (half kick first): the velocity at the half step,
+            // v = v₀ + (n − ½) g Δt, and the exact parabola x_n = x₀ + v₀ t + g t²/2, t = n Δt.
+            let want_v = v + g * ((nf - 0.5) * dt);
+            let want_x = x + v * (nf * dt) + g * (dt * dt * nf * nf / 2.0);
             // 1e-12 m: a few roundings of O(1) positions over ten steps.
             assert!((sim.particles().v[p] - want_v).norm() < 1e-12, "step {n} drop {p} velocity");
             assert!((sim.particles().x[p] - want_x).norm() < 1e-12, "step {n} drop {p} position");
