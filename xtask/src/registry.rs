@@ -66,8 +66,10 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::curve_skin::register(&mut v);
     crate::scenes::rigging::register(&mut v);
     crate::scenes::motion_graph::register(&mut v);
+    crate::scenes::perf_control::register(&mut v);
     crate::scenes::flip_tet::register(&mut v);
     crate::scenes::flip_tet_adaptive::register(&mut v);
+    crate::scenes::wrinkles::register(&mut v);
     v
 }
 
@@ -117,10 +119,22 @@ pub fn benches() -> Vec<Bench> {
             sweeps: &[],
         },
         Bench {
+            crate_name: "perf-control",
+            description: "perf-control: beam width, working rate, database size, stretch limit and k vs DP time and walk tracking error",
+            run: crate::bench_perf_control::run,
+            sweeps: crate::bench_perf_control::SWEEPS,
+        },
+        Bench {
             crate_name: "flip-tet",
             description: "flip-tet: resolution, adaptivity levels, solver tolerance and boundary order vs dam-break front error, rest speed and time",
             run: crate::bench_flip_tet::run,
             sweeps: crate::bench_flip_tet::SWEEPS,
+        },
+        Bench {
+            crate_name: "wrinkles",
+            description: "wrinkles: quadrature tolerance, gradient bins, mode, smoothing and subdivision level vs coefficient/h/area error and time",
+            run: crate::bench_wrinkles::run,
+            sweeps: &[],
         },
     ]
 }

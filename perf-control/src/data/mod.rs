@@ -1,0 +1,8 @@
+//! Procedural example data (spec §3.13): walks from geom-core's synthesiser with an exact
+//! segmentation at foot plants, and mouse-like paths.
+
+pub mod mouse;
+pub mod walk;
+
+pub use mouse::{mouse_path, straight_stroke};
+pub use walk::{take_from_walk, walk_motion, walk_motion_with_turns, walk_take, SharpTurn};

@@ -1,0 +1,255 @@
+//! `cargo xtask bench wrinkles` (spec §9): accuracy against time for the knobs of the wrinkle
+//! pipeline on a 0.5 m sheet (12² quads = 288 triangles; quick: 6² = 72) carrying a `Folds`
+//! pattern, gathered towards the top edge:
+//! (a) `precompute.tolerance` 1e-2 … 1e-6 — precompute ms against the max relative C4 error vs a
+//!     τ = 1e-8 reference;
+//! (b) `gradient_bins` K ∈ {8, 18, 32, 72, 128, 0 = all} — exact-mode ms per frame against the
+//!     max relative h error vs K = 0;
+//! (c) mode Linearized vs ExactFlatRest vs PrincipalLength — ms per frame against the mean
+//!     per-triangle area residual (against each mode's own target);
+//! (d) smoothing VertexAverage vs AreaConsistent — ms per frame against the mean rendered area
+//!     residual |A_rendered − A*|/A* (degree-5 rule on 4² sub-triangles);
+//! (e) displaced-mesh level L ∈ {2, 4, 8, 16} — ms per mesh against the relative surface-area
+//!     error vs L = 32.
+//! Writes `bench.csv` and `pareto.png` (error against ms, one series per knob).
+
+use std::time::Instant;
+
+use geom_core::math::Pt3;
+use geom_core::procedural::{grid, Diagonals, GridSpec, Plane};
+use wrinkles::{
+    precompute, AreaCheck, HMax, ModulationMode, ModulationOptions, Normalization, PatternOptions, PatternSource,
+    PrecomputeOptions, Procedural, RestMesh, Smoothing, StrainMeasure, VertexWeights, WrinkleAnimator, WrinklePattern,
+};
+
+use crate::error::{Error, Result};
+use crate::out::{Cell, CsvWriter, Summary};
+use crate::plot::{LinePlot, Series};
+use crate::registry::BenchCtx;
+
+fn wr<T>(r: wrinkles::Result<T>) -> Result<T> {
+    r.map_err(|e| Error::Run(format!("wrinkles: {e}")))
+}
+
+/// Mean seconds of `f`, repeated for at least `min` seconds (and twice).
+fn time_it(min: f64, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
+    f()?;
+    let t0 = Instant::now();
+    let mut n = 0usize;
+    while n < 2 || t0.elapsed().as_secs_f64() < min {
+        f()?;
+        n += 1;
+    }
+    Ok(t0.elapsed().as_secs_f64() / n as f64)
+}
+
+/// Runs the sweep.
+pub fn run(ctx: &BenchCtx) -> Result<Summary> {
+    let quads = if ctx.quick { 6 } else { 12 };
+    let min_t = if ctx.quick { 0.05 } else { 0.3 };
+    let l = 0.5;
+    let m = grid(&GridSpec {
+        quads: [quads, quads],
+        size: [l, l],
+        plane: Plane::XY,
+        diagonals: Diagonals::Alternating,
+        center: Pt3::new(0.5 * l, 0.5 * l, 0.0),
+    })?;
+    let mesh = wr(RestMesh::from_trimesh(&m))?;
+    let pat = wr(WrinklePattern::new(
+        &PatternSource::Procedural(Procedural::Folds {
+            wavelength_uv: 0.08,
+            angle_deg: 0.0,
+            spread_deg: 8.0,
+            count: 4,
+            irregularity: 0.3,
+            seed: 7,
+        }),
+        PatternOptions { normalization: Normalization::TargetRestSlope(0.5), ..Default::default() },
+    ))?;
+    let pats = [pat];
+    // Gather: x squeezed towards the top edge (up to 40 %), a gentle bulge.
+    let def: Vec<Pt3> = mesh
+        .positions
+        .iter()
+        .map(|p| {
+            let s = 1.0 - 0.4 * p.y / l;
+            Pt3::new(0.5 * l + (p.x - 0.5 * l) * s, p.y, 0.02 * (std::f64::consts::PI * p.x / l).sin())
+        })
+        .collect();
+    let mut csv =
+        CsvWriter::create(&ctx.out_dir.join("bench.csv"), &["knob", "value", "precompute_ms", "ms", "error"])?;
+    let mut summary = Summary::new();
+    summary.set_str("profile", if cfg!(debug_assertions) { "debug" } else { "release" });
+    summary.set_count("triangles", mesh.faces.len() as u64);
+    let mut series: Vec<Series> = Vec::new();
+
+    // (a) tolerance.
+    let reference = wr(precompute(
+        &mesh,
+        &pats,
+        &PrecomputeOptions { tolerance: 1e-8, max_depth: 10, gradient_bins: 0, gradient_samples: false },
+    ))?;
+    let mut pts = Vec::new();
+    let tols: &[f64] = if ctx.quick { &[1e-2, 1e-3, 1e-4] } else { &[1e-2, 1e-3, 1e-4, 1e-5, 1e-6] };
+    for &tol in tols {
+        let o = PrecomputeOptions { tolerance: tol, max_depth: 10, gradient_bins: 72, gradient_samples: true };
+        let mut rig = None;
+        let secs = time_it(min_t, || {
+            rig = Some(wr(precompute(&mesh, &pats, &o))?);
+            Ok(())
+        })?;
+        let rig = rig.expect("time_it runs the closure at least once");
+        let err = rig
+            .coeffs
+            .iter()
+            .zip(&reference.coeffs)
+            .map(|(a, b)| (a.c4 - b.c4).abs() / b.c4.max(1e-300))
+            .fold(0.0, f64::max);
+        csv.row(&[Cell::Text("tolerance".into()), tol.into(), (1e3 * secs).into(), (1e3 * secs).into(), err.into()])?;
+        summary.set(&format!("precompute_ms_tol{tol:e}"), 1e3 * secs);
+        summary.set(&format!("c4_max_rel_err_tol{tol:e}"), err);
+        pts.push((1e3 * secs, err.max(1e-16)));
+    }
+    series.push(Series::new("tolerance (precompute ms)", pts));
+
+    // (b) gradient bins, exact flat mode.
+    let flat = ModulationOptions {
+        mode: ModulationMode::ExactFlatRest,
+        smoothing: Smoothing::PerTriangle,
+        h_max: HMax::Fixed(1e3),
+        ..Default::default()
+    };
+    let ref_rig = wr(precompute(
+        &mesh,
+        &pats,
+        &PrecomputeOptions { tolerance: 1e-4, max_depth: 8, gradient_bins: 0, gradient_samples: true },
+    ))?;
+    let mut ra = wr(WrinkleAnimator::new(ref_rig, flat.clone()))?;
+    let h_ref = wr(ra.frame(&def))?.tri_h;
+    let mut pts = Vec::new();
+    for k in [8usize, 18, 32, 72, 128, 0] {
+        let t0 = Instant::now();
+        let rig = wr(precompute(
+            &mesh,
+            &pats,
+            &PrecomputeOptions { tolerance: 1e-4, max_depth: 8, gradient_bins: k, gradient_samples: true },
+        ))?;
+        let pre = t0.elapsed().as_secs_f64();
+        let mut a = wr(WrinkleAnimator::new(rig, flat.clone()))?;
+        let mut h = Vec::new();
+        let secs = time_it(min_t, || {
+            h = wr(a.frame(&def))?.tri_h;
+            Ok(())
+        })?;
+        let err = h.iter().zip(&h_ref).filter(|(_, r)| **r > 0.0).map(|(x, r)| (x - r).abs() / r).fold(0.0, f64::max);
+        csv.row(&[
+            Cell::Text("gradient_bins".into()),
+            (k as f64).into(),
+            (1e3 * pre).into(),
+            (1e3 * secs).into(),
+            err.into(),
+        ])?;
+        summary.set(&format!("exact_ms_per_frame_K{k}"), 1e3 * secs);
+        summary.set(&format!("h_max_rel_err_K{k}"), err);
+        if k > 0 {
+            pts.push((1e3 * secs, err.max(1e-16)));
+        }
+    }
+    series.push(Series::new("gradient bins (exact ms/frame)", pts));
+
+    // (c) mode and (d) smoothing on the default rig.
+    let rig = wr(precompute(&mesh, &pats, &PrecomputeOptions::default()))?;
+    let mean_c4 = rig.coeffs.iter().map(|c| c.c4).sum::<f64>() / rig.coeffs.len().max(1) as f64;
+    let mut pts = Vec::new();
+    for (name, mode) in [
+        ("linearized", ModulationMode::Linearized { strain: StrainMeasure::Green }),
+        ("exact_wrinkled", ModulationMode::ExactWrinkledRest),
+        ("exact_flat", ModulationMode::ExactFlatRest),
+        ("principal_length", ModulationMode::PrincipalLength),
+    ] {
+        let o = ModulationOptions {
+            mode,
+            smoothing: Smoothing::PerTriangle,
+            h_max: HMax::Fixed(1e3),
+            ..Default::default()
+        };
+        let mut a = wr(WrinkleAnimator::new(rig.clone(), o))?;
+        let mut fm = None;
+        let secs = time_it(min_t, || {
+            fm = Some(wr(a.frame(&def))?);
+            Ok(())
+        })?;
+        let fm = fm.expect("ran");
+        let rep = wr(a.area_report(&def, &fm, AreaCheck::PerTriangle))?;
+        csv.row(&[
+            Cell::Text("mode".into()),
+            Cell::Text(name.into()),
+            0.0.into(),
+            (1e3 * secs).into(),
+            rep.mean_rel.into(),
+        ])?;
+        summary.set(&format!("ms_per_frame_{name}"), 1e3 * secs);
+        summary.set(&format!("area_residual_mean_{name}"), rep.mean_rel);
+        pts.push((1e3 * secs, rep.mean_rel.max(1e-16)));
+    }
+    series.push(Series::new("mode (ms/frame)", pts));
+    let mut pts = Vec::new();
+    for (name, sm) in [
+        ("per_triangle", Smoothing::PerTriangle),
+        ("vertex_average", Smoothing::VertexAverage { weights: VertexWeights::Area }),
+        ("area_consistent", Smoothing::AreaConsistent { mu: 1e-3 * mean_c4 }),
+    ] {
+        let o = ModulationOptions {
+            mode: ModulationMode::ExactFlatRest,
+            smoothing: sm,
+            h_max: HMax::Fixed(1e3),
+            ..Default::default()
+        };
+        let mut a = wr(WrinkleAnimator::new(rig.clone(), o))?;
+        let mut fm = None;
+        let secs = time_it(min_t, || {
+            fm = Some(wr(a.frame(&def))?);
+            Ok(())
+        })?;
+        let fm = fm.expect("ran");
+        let rep = wr(a.area_report(&def, &fm, AreaCheck::Rendered { level: 2 }))?;
+        csv.row(&[
+            Cell::Text("smoothing".into()),
+            Cell::Text(name.into()),
+            0.0.into(),
+            (1e3 * secs).into(),
+            rep.mean_rel.into(),
+        ])?;
+        summary.set(&format!("ms_per_frame_{name}"), 1e3 * secs);
+        summary.set(&format!("rendered_area_residual_mean_{name}"), rep.mean_rel);
+        pts.push((1e3 * secs, rep.mean_rel.max(1e-16)));
+    }
+    series.push(Series::new("smoothing (ms/frame)", pts));
+
+    // (e) displaced-mesh level.
+    let mut a = wr(WrinkleAnimator::new(rig.clone(), ModulationOptions::default()))?;
+    let fm = wr(a.frame(&def))?;
+    let area_ref = wr(a.displaced_mesh(&def, &fm, 32))?.area();
+    let mut pts = Vec::new();
+    for lv in [2u32, 4, 8, 16] {
+        let mut area = 0.0;
+        let secs = time_it(min_t, || {
+            area = wr(a.displaced_mesh(&def, &fm, lv))?.area();
+            Ok(())
+        })?;
+        let err = (area - area_ref).abs() / area_ref;
+        csv.row(&[Cell::Text("level".into()), (lv as f64).into(), 0.0.into(), (1e3 * secs).into(), err.into()])?;
+        summary.set(&format!("ms_displaced_mesh_L{lv}"), 1e3 * secs);
+        summary.set(&format!("surface_area_rel_err_L{lv}"), err);
+        pts.push((1e3 * secs, err.max(1e-16)));
+    }
+    series.push(Series::new("subdivision L (ms/mesh)", pts));
+
+    let mut plot = LinePlot::new("wrinkles: error against time", "ms", "error (relative)").log(true, true);
+    for s in series {
+        plot = plot.with(s);
+    }
+    plot.write_png(&ctx.out_dir.join("pareto.png"))?;
+    Ok(summary)
+}
