@@ -123,6 +123,8 @@ impl LinePlot {
                     .x_desc(&self.x_label)
                     .y_desc(&self.y_label)
                     .label_style(("sans-serif", 14))
+                    .x_label_formatter(&|v: &f64| tick_label(*v))
+                    .y_label_formatter(&|v: &f64| tick_label(*v))
                     .draw()
                     .map_err(|e| plot_err(&e))?;
                 for (i, s) in self.series.iter().enumerate() {
@@ -159,9 +161,46 @@ impl LinePlot {
     }
 }
 
+/// An axis tick as a short label: three significant digits, trailing zeros dropped, scientific
+/// notation outside [1e-3, 1e5). Log axes put ticks at values such as `9.999999999999999e-5` (the
+/// float nearest 10⁻⁴ reached by repeated division); printed raw they overflow the label area.
+pub fn tick_label(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let a = v.abs();
+    if !(1e-3..1e5).contains(&a) {
+        let s = format!("{v:.2e}");
+        let (mant, exp) = s.split_once('e').unwrap_or((&s, "0"));
+        let mant = if mant.contains('.') { mant.trim_end_matches('0').trim_end_matches('.') } else { mant };
+        return format!("{mant}e{exp}");
+    }
+    let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick_label(9.999999999999999e-5), "1e-4");
+        assert_eq!(tick_label(1e-9), "1e-9");
+        assert_eq!(tick_label(2.5e-7), "2.5e-7");
+        assert_eq!(tick_label(0.30000000000000004), "0.3");
+        assert_eq!(tick_label(0.125), "0.125");
+        assert_eq!(tick_label(0.001), "0.001");
+        assert_eq!(tick_label(250.0), "250");
+        assert_eq!(tick_label(-12.5), "-12.5");
+        assert_eq!(tick_label(123456.0), "1.23e5");
+        assert_eq!(tick_label(0.0), "0");
+    }
 
     #[test]
     fn renders_log_log_png_with_bundled_font() {
