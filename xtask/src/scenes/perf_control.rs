@@ -625,3 +625,41 @@ pub fn run_real(ctx: &RunCtx) -> Result<Summary> {
     s.set("refine_s", d.refine_s);
     Ok(s)
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::registry::builtin_scenes;
+    use crate::run::run_scene;
+    use crate::scene::Mode;
+
+    /// Every built-in perf-control scene parses and runs end to end in quick mode (each well under
+    /// a second in release), and the quick walk and mouse-path runs meet the spec's tracking targets
+    /// (PC-1: midpoint RMS ≤ 0.10 m, heading RMS ≤ 10°; PC-3: path RMS ≤ 0.15 m). Quick mode uses
+    /// a smaller database, so the stride and phase figures are left to the default run.
+    #[test]
+    fn perf_control_scenes_run_quick() {
+        let root = std::env::temp_dir().join(format!("xtask-pc-scenes-{}", std::process::id()));
+        let mut ran = 0;
+        for s in builtin_scenes().unwrap().into_iter().filter(|s| s.id.starts_with("perf-control/")) {
+            let dir = root.join(&s.id);
+            let sum = run_scene(&s.id, &s.file, Mode::Quick, &dir).unwrap_or_else(|e| panic!("{}: {e}", s.id));
+            assert!(dir.join("summary.json").is_file(), "{}: no summary.json", s.id);
+            match s.id.as_str() {
+                "perf-control/walk" => {
+                    assert!(sum.get("long_mid_rms_m").unwrap() <= 0.10);
+                    assert!(sum.get("short_mid_rms_m").unwrap() <= 0.10);
+                    assert!(sum.get("long_heading_rms_deg").unwrap() <= 10.0);
+                }
+                "perf-control/mouse-paths" => assert!(sum.get("path_rms_m_worst").unwrap() <= 0.15),
+                "perf-control/walk-timing" => {
+                    assert!(sum.get("beam_score_excess_rel").unwrap() >= 0.0);
+                    assert!(sum.get("gemm_score_diff_rel").unwrap() < 1e-9);
+                }
+                _ => {}
+            }
+            ran += 1;
+        }
+        assert!(ran >= 4, "expected the four perf-control scenes, ran {ran}");
+        std::fs::remove_dir_all(&root).unwrap();
+    }
+}
