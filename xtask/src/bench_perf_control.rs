@@ -39,15 +39,57 @@ struct Setup {
     quick: bool,
 }
 
-/// One evaluation: database reduced to `size` at `factor`, DP with `p`; returns (DP s, score,
-/// tracking RMS after refinement + skeletal output, coarse-only RMS, max seam jump).
-fn evaluate(
-    s: &Setup,
-    factor: usize,
-    size: Option<usize>,
-    mode: ClusterDistance,
-    p: &DpParams,
-) -> Result<(f64, f64, f64, f64, f64, usize)> {
+/// What one evaluation measured.
+struct Eval {
+    /// DP wall time (s).
+    dp_s: f64,
+    /// DP score `S` (m²).
+    score: f64,
+    /// Tracking RMS after refinement and skeletal output (m).
+    rms: f64,
+    /// Tracking RMS of the coarse placed control, refinement off (m).
+    coarse_rms: f64,
+    /// Largest raw seam jump of the target points, before blending (m).
+    jump: f64,
+    /// DP columns `P`.
+    columns: usize,
+}
+
+impl Eval {
+    /// Writes one CSV row (the columns of `HEADER`).
+    fn row(&self, csv: &mut CsvWriter, sweep: &str, value: f64, mode: &str, excess: f64) -> Result<()> {
+        csv.row(&[
+            sweep.into(),
+            value.into(),
+            mode.into(),
+            self.dp_s.into(),
+            self.score.into(),
+            excess.into(),
+            self.rms.into(),
+            self.coarse_rms.into(),
+            self.jump.into(),
+            self.columns.into(),
+        ])
+    }
+}
+
+/// The CSV columns of every sweep.
+const HEADER: [&str; 10] = [
+    "sweep",
+    "value",
+    "mode",
+    "dp_s",
+    "score",
+    "score_excess_rel",
+    "track_rms_m",
+    "coarse_rms_m",
+    "seam_jump_max_m",
+    "columns",
+];
+
+/// One evaluation: database reduced to `size` at `factor` (working rate 30/factor Hz), DP with `p`,
+/// refinement to 30 Hz and skeletal output.
+fn evaluate(s: &Setup, factor: usize, size: Option<usize>, mode: ClusterDistance, p: &DpParams) -> Result<Eval> {
     let mut db = pc(MappingDb::from_takes(vec![s.take.clone()], 30.0 / factor as f64))?;
     if let Some(n) = size.filter(|&n| n < db.instances.len()) {
         pc(db.cluster(&ClusterOptions {
@@ -70,23 +112,7 @@ fn evaluate(
     let pts = pc(target_points(&fine_db, &fine, false))?;
     let seams: Vec<usize> = fine.segments[1..].iter().filter(|c| c.start > 0).map(|c| c.start as usize).collect();
     let jump = seam_jumps(&pts, &seams).0.into_iter().fold(0.0, f64::max);
-    Ok((dp_s, it.score, rms, coarse_rms, jump, it.stats.columns))
-}
-
-fn base(quick: bool) -> (DpParams, usize) {
-    (
-        DpParams {
-            k: 10.0,
-            stretch_limit_s: 0.2,
-            beam: None,
-            partial_ends: true,
-            continuity_order: 0,
-            k_vel: 0.0,
-            forced: vec![],
-            gemm: false,
-        },
-        if quick { 40 } else { 70 },
-    )
+    Ok(Eval { dp_s, score: it.score, rms, coarse_rms, jump, columns: it.stats.columns })
 }
 
 /// Runs the selected sweeps.
@@ -104,21 +130,11 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     };
     let mut summary = Summary::new();
     summary.set_str("mode", if quick { "quick" } else { "default" });
-    let header = [
-        "sweep",
-        "value",
-        "mode",
-        "dp_s",
-        "score",
-        "score_excess_rel",
-        "track_rms_m",
-        "coarse_rms_m",
-        "seam_jump_max_m",
-        "columns",
-    ];
     for sw in sel {
-        let mut csv = CsvWriter::create(&ctx.out_dir.join(format!("pc_{sw}.csv")), &header)?;
-        let (p0, size) = base(s.quick);
+        let mut csv = CsvWriter::create(&ctx.out_dir.join(format!("pc_{sw}.csv")), &HEADER)?;
+        // The walk defaults of spec §4 (k = 10, ±0.2 s, exact, partial ends); PC-1's database size.
+        let p0 = DpParams::default();
+        let size = if s.quick { 40 } else { 70 };
         let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
         let mut add = |label: &str, pt: (f64, f64)| {
             if let Some(e) = series.iter_mut().find(|e| e.0 == label) {
@@ -135,25 +151,14 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                     let mut p = p0.clone();
                     p.beam = Some(w);
                     let r = evaluate(&s, 3, Some(size), ClusterDistance::ControlAndTarget, &p)?;
-                    let excess = (r.1 - exact.1) / exact.1;
-                    csv.row(&[
-                        "beam".into(),
-                        w.into(),
-                        "".into(),
-                        r.0.into(),
-                        r.1.into(),
-                        excess.into(),
-                        r.2.into(),
-                        r.3.into(),
-                        r.4.into(),
-                        r.5.into(),
-                    ])?;
-                    add("beam widths", (r.0, excess.max(1e-9)));
-                    if excess <= 0.01 && (r.2 - exact.2).abs() <= 1e-3 && w < chosen {
+                    let excess = (r.score - exact.score) / exact.score;
+                    r.row(&mut csv, "beam", w, "", excess)?;
+                    add("beam widths", (r.dp_s, excess.max(1e-9)));
+                    if excess <= 0.01 && (r.rms - exact.rms).abs() <= 1e-3 && w < chosen {
                         chosen = w;
                     }
                 }
-                summary.set("beam_exact_dp_s", exact.0);
+                summary.set("beam_exact_dp_s", exact.dp_s);
                 summary.set("beam_default_w", chosen);
                 ("DP time (s)", "relative score excess (floored at 1e-9)")
             }
@@ -165,20 +170,9 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                     let mut p = p0.clone();
                     p.beam = Some(0.3);
                     let r = evaluate(&s, f, Some(size), ClusterDistance::ControlAndTarget, &p)?;
-                    csv.row(&[
-                        "rate".into(),
-                        hz.into(),
-                        "beam0.3".into(),
-                        r.0.into(),
-                        r.1.into(),
-                        f64::NAN.into(),
-                        r.2.into(),
-                        r.3.into(),
-                        r.4.into(),
-                        r.5.into(),
-                    ])?;
-                    add("refined (30 Hz skeleton)", (r.0, r.2));
-                    add("coarse placed control", (r.0, r.3));
+                    r.row(&mut csv, "rate", hz, "beam0.3", f64::NAN)?;
+                    add("refined (30 Hz skeleton)", (r.dp_s, r.rms));
+                    add("coarse placed control", (r.dp_s, r.coarse_rms));
                 }
                 ("DP time (s)", "tracking RMS (m)")
             }
@@ -194,19 +188,8 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                         p.beam = Some(0.3);
                         let r = evaluate(&s, 3, n, mode, &p)?;
                         let v = n.map_or(f64::NAN, |n| n as f64);
-                        csv.row(&[
-                            "cluster".into(),
-                            v.into(),
-                            format!("{mode:?}").into(),
-                            r.0.into(),
-                            r.1.into(),
-                            f64::NAN.into(),
-                            r.2.into(),
-                            r.3.into(),
-                            r.4.into(),
-                            r.5.into(),
-                        ])?;
-                        add(&format!("{mode:?}"), (r.0, r.2));
+                        r.row(&mut csv, "cluster", v, &format!("{mode:?}"), f64::NAN)?;
+                        add(&format!("{mode:?}"), (r.dp_s, r.rms));
                     }
                 }
                 ("DP time (s)", "tracking RMS (m)")
@@ -217,19 +200,8 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                     p.stretch_limit_s = lim;
                     p.beam = Some(0.3);
                     let r = evaluate(&s, 3, Some(size), ClusterDistance::ControlAndTarget, &p)?;
-                    csv.row(&[
-                        "stretch".into(),
-                        lim.into(),
-                        "beam0.3".into(),
-                        r.0.into(),
-                        r.1.into(),
-                        f64::NAN.into(),
-                        r.2.into(),
-                        r.3.into(),
-                        r.4.into(),
-                        r.5.into(),
-                    ])?;
-                    add("stretch limits", (r.0, r.2));
+                    r.row(&mut csv, "stretch", lim, "beam0.3", f64::NAN)?;
+                    add("stretch limits", (r.dp_s, r.rms));
                 }
                 ("DP time (s)", "tracking RMS (m)")
             }
@@ -239,20 +211,9 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                     p.k = k;
                     p.beam = Some(0.3);
                     let r = evaluate(&s, 3, Some(size), ClusterDistance::ControlAndTarget, &p)?;
-                    csv.row(&[
-                        "k".into(),
-                        k.into(),
-                        "beam0.3".into(),
-                        r.0.into(),
-                        r.1.into(),
-                        f64::NAN.into(),
-                        r.2.into(),
-                        r.3.into(),
-                        r.4.into(),
-                        r.5.into(),
-                    ])?;
-                    add("tracking RMS (m)", (k, r.2));
-                    add("max raw seam jump (m)", (k, r.4));
+                    r.row(&mut csv, "k", k, "beam0.3", f64::NAN)?;
+                    add("tracking RMS (m)", (k, r.rms));
+                    add("max raw seam jump (m)", (k, r.jump));
                 }
                 ("k", "metres")
             }
