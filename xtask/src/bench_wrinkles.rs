@@ -18,8 +18,9 @@ use std::time::Instant;
 use geom_core::math::Pt3;
 use geom_core::procedural::{grid, Diagonals, GridSpec, Plane};
 use wrinkles::{
-    precompute, AreaCheck, HMax, ModulationMode, ModulationOptions, Normalization, PatternOptions, PatternSource,
-    PrecomputeOptions, Procedural, RestMesh, Smoothing, StrainMeasure, VertexWeights, WrinkleAnimator, WrinklePattern,
+    precompute, AreaCheck, AreaReport, HMax, ModulationMode, ModulationOptions, Normalization, PatternOptions,
+    PatternSource, PrecomputeOptions, Procedural, RestMesh, Smoothing, StrainMeasure, VertexWeights, WrinkleAnimator,
+    WrinklePattern, WrinkleRig,
 };
 
 use crate::error::{Error, Result};
@@ -41,6 +42,25 @@ fn time_it(min: f64, mut f: impl FnMut() -> Result<()>) -> Result<f64> {
         n += 1;
     }
     Ok(t0.elapsed().as_secs_f64() / n as f64)
+}
+
+/// Mean seconds per `frame` of a fresh animator with options `o` on the deformed positions `def`,
+/// and the area report of the last frame.
+fn timed_frame(
+    rig: &WrinkleRig,
+    o: ModulationOptions,
+    def: &[Pt3],
+    min_t: f64,
+    check: AreaCheck,
+) -> Result<(f64, AreaReport)> {
+    let mut a = wr(WrinkleAnimator::new(rig.clone(), o))?;
+    let mut fm = None;
+    let secs = time_it(min_t, || {
+        fm = Some(wr(a.frame(def))?);
+        Ok(())
+    })?;
+    let fm = fm.expect("time_it runs the frame at least once");
+    Ok((secs, wr(a.area_report(def, &fm, check))?))
 }
 
 /// Runs the sweep.
@@ -174,14 +194,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             h_max: HMax::Fixed(1e3),
             ..Default::default()
         };
-        let mut a = wr(WrinkleAnimator::new(rig.clone(), o))?;
-        let mut fm = None;
-        let secs = time_it(min_t, || {
-            fm = Some(wr(a.frame(&def))?);
-            Ok(())
-        })?;
-        let fm = fm.expect("ran");
-        let rep = wr(a.area_report(&def, &fm, AreaCheck::PerTriangle))?;
+        let (secs, rep) = timed_frame(&rig, o, &def, min_t, AreaCheck::PerTriangle)?;
         csv.row(&[
             Cell::Text("mode".into()),
             Cell::Text(name.into()),
@@ -206,14 +219,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             h_max: HMax::Fixed(1e3),
             ..Default::default()
         };
-        let mut a = wr(WrinkleAnimator::new(rig.clone(), o))?;
-        let mut fm = None;
-        let secs = time_it(min_t, || {
-            fm = Some(wr(a.frame(&def))?);
-            Ok(())
-        })?;
-        let fm = fm.expect("ran");
-        let rep = wr(a.area_report(&def, &fm, AreaCheck::Rendered { level: 2 }))?;
+        let (secs, rep) = timed_frame(&rig, o, &def, min_t, AreaCheck::Rendered { level: 2 })?;
         csv.row(&[
             Cell::Text("smoothing".into()),
             Cell::Text(name.into()),
