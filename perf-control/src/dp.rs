@@ -360,7 +360,8 @@ fn gemm_relax(
     back: &mut [u32],
     stats: &mut DpStats,
 ) {
-    use geom_core::faer::{linalg::matmul::matmul, Accum, Mat, Par};
+    use geom_core::faer::{Accum, Mat, Par};
+    use geom_core::linalg::dense::matmul;
     let (kt, np) = (g.kt, g.np);
     let succ: Vec<usize> = (0..np).filter(|&c| g.succ_d[c].is_finite()).collect();
     if succ.is_empty() || live.is_empty() {

@@ -225,7 +225,7 @@ impl BorderedLlt {
                     // One dense product per supernode: Y_s Y_sᵀ (|rows| × |rows|).
                     let ys = Mat::<f64>::from_fn(rows.len(), nc, |a, c| v[(rows[a].0, c)]);
                     let mut prod = Mat::<f64>::zeros(rows.len(), rows.len());
-                    faer::linalg::matmul::matmul(
+                    super::dense::matmul(
                         prod.as_mut(),
                         faer::Accum::Replace,
                         ys.as_ref(),

@@ -1,6 +1,7 @@
-//! Small dense helpers over `faer::Mat<f64>`: Cholesky ([`llt`]) and numerical rank ([`rank`]),
-//! with the same typed errors as the sparse solvers (tracks' Schur complements, barnet's small
-//! constraint blocks).
+//! Small dense helpers over `faer::Mat<f64>`: Cholesky ([`llt`]), numerical rank ([`rank`]) and
+//! the matrix product ([`matmul`], faer's with the vector-register state cleaned up after it, see
+//! [`super::zero_upper`]), with the same typed errors as the sparse solvers (tracks' Schur
+//! complements, barnet's small constraint blocks).
 
 use crate::error::{Error, Result};
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -19,6 +20,15 @@ pub struct DenseLlt {
 
 fn is_finite(m: MatRef<'_, f64>) -> bool {
     super::llt::mat_is_finite(m)
+}
+
+/// `C = α·A·B` (`accum = Replace`) or `C += α·A·B` (`Accum::Add`): faer's `matmul` followed by
+/// [`super::zero_upper`]. Call this instead of faer's `matmul` directly: faer leaves the upper
+/// halves of the vector registers dirty, which slows every later scalar instruction of the
+/// process 15–24× (see the `upper_state` module docs).
+pub fn matmul(c: MatMut<'_, f64>, accum: faer::Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>, alpha: f64, par: Par) {
+    faer::linalg::matmul::matmul(c, accum, a, b, alpha, par);
+    super::zero_upper();
 }
 
 /// Cholesky factorisation of a symmetric positive definite matrix (lower triangle read).
@@ -149,5 +159,28 @@ mod tests {
         let mut bad = Mat::<f64>::identity(2, 2);
         bad[(0, 1)] = f64::INFINITY;
         assert!(matches!(rank(&bad, 1e-12), Err(Error::NonFinite(_))));
+    }
+
+    #[test]
+    fn matmul_matches_the_naive_product_and_accumulates() {
+        // Integer-valued entries: every product and partial sum is exact in f64, so the faer
+        // kernels' summation order cannot matter and the comparison is exact.
+        let a = Mat::from_fn(7, 5, |i, j| (i as f64) - 2.0 * (j as f64));
+        let b = Mat::from_fn(5, 9, |i, j| ((i * j) % 4) as f64 - 1.0);
+        let mut c = Mat::<f64>::zeros(7, 9);
+        matmul(c.as_mut(), faer::Accum::Replace, a.as_ref(), b.as_ref(), 2.0, Par::Seq);
+        for i in 0..7 {
+            for j in 0..9 {
+                let naive: f64 = (0..5).map(|k| a[(i, k)] * b[(k, j)]).sum();
+                assert_eq!(c[(i, j)], 2.0 * naive);
+            }
+        }
+        matmul(c.as_mut(), faer::Accum::Add, a.as_ref(), b.as_ref(), -1.0, Par::Seq);
+        for i in 0..7 {
+            for j in 0..9 {
+                let naive: f64 = (0..5).map(|k| a[(i, k)] * b[(k, j)]).sum();
+                assert_eq!(c[(i, j)], naive);
+            }
+        }
     }
 }

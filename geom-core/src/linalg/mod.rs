@@ -29,6 +29,7 @@ mod pattern;
 mod precond;
 mod symbolic;
 mod triplets;
+mod upper_state;
 mod vector;
 
 pub use bordered::BorderedLlt;
@@ -41,6 +42,7 @@ pub use pattern::FixedPattern;
 pub use precond::{Ic0, Identity, Jacobi, Preconditioner, IC0_PIVOT_SIGMA};
 pub use symbolic::{LltSymbolic, Ordering};
 pub use triplets::Triplets;
+pub use upper_state::zero_upper;
 pub use vector::{
     all_finite, as_pt3, as_pt3_mut, as_vec3, as_vec3_mut, dot, flat, flat_mut, flat_vec, flat_vec_mut, norm2, DOT_CHUNK,
 };

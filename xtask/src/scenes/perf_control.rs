@@ -385,8 +385,8 @@ pub fn run_timing(ctx: &RunCtx) -> Result<Summary> {
             }
         }
     }
-    // GEMM variant last: after faer's AVX kernels the rest of the process ran 5–8× slower on
-    // this machine (see README), so it must not precede the other timings.
+    // GEMM variant last. Before geom-core's `dense::matmul` (faer's product + `vzeroupper`), the
+    // rest of the process ran 5–8× slower after it (see README); the order is kept as a guard.
     let mut gemm_p = exact_p.clone();
     gemm_p.gemm = true;
     let tg = Instant::now();
