@@ -24,8 +24,8 @@ fn is_finite(m: MatRef<'_, f64>) -> bool {
 
 /// `C = α·A·B` (`accum = Replace`) or `C += α·A·B` (`Accum::Add`): faer's `matmul` followed by
 /// [`super::zero_upper`]. Call this instead of faer's `matmul` directly: faer leaves the upper
-/// halves of the vector registers dirty, which slows every later scalar instruction of the
-/// process 15–24× (see the `upper_state` module docs).
+/// halves of the vector registers dirty, which slows later scalar code 15–21× until something
+/// cleans the state (see the `upper_state` module docs).
 pub fn matmul(c: MatMut<'_, f64>, accum: faer::Accum, a: MatRef<'_, f64>, b: MatRef<'_, f64>, alpha: f64, par: Par) {
     faer::linalg::matmul::matmul(c, accum, a, b, alpha, par);
     super::zero_upper();

@@ -4,12 +4,12 @@
 //! registers dirty (its AVX-512 kernels end without `vzeroupper`). Everything in this workspace is
 //! compiled for baseline x86-64, so scalar `f64` code uses legacy-SSE encodings, and with a dirty
 //! upper state every such instruction carries a merge dependency on the full register: measured on
-//! this project's 2-core Xeon (Sapphire Rapids), a scalar loop ran **15–24× slower for the rest of
-//! the process** after one 64×12·12×64 product, and at full speed again after `vzeroupper`
-//! (`cargo run --release -p geom-core --example upper_state`). faer's sparse and dense Cholesky and
-//! LDLᵀ factorisations and solves leave the state clean (measured the same way), so only direct
-//! `matmul` calls need it: use [`super::dense::matmul`], which calls [`zero_upper`] after the
-//! product.
+//! this project's 2-core Xeon (Sapphire Rapids), a scalar loop ran **15–21× slower** after one
+//! 64×12·12×64 product — until some later AVX code happened to execute `vzeroupper` — and at full
+//! speed again right after [`zero_upper`] (`cargo run --release -p geom-core --example
+//! upper_state`). faer's sparse and dense Cholesky and LDLᵀ factorisations and solves do not dirty
+//! the state (measured the same way), so only direct `matmul` calls need it: use
+//! [`super::dense::matmul`], which calls [`zero_upper`] after the product.
 
 /// Executes `vzeroupper` when the CPU has AVX (a no-op elsewhere); about one cycle.
 #[inline]
