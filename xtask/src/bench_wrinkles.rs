@@ -63,6 +63,23 @@ fn timed_frame(
     Ok((secs, wr(a.area_report(def, &fm, check))?))
 }
 
+/// Records one per-frame measurement of knob `(knob, name)`: a CSV row, the summary keys
+/// `ms_per_frame_{name}` and `{error_key}_{name}`, and a point (ms, error) of the knob's series.
+fn record_frame(
+    csv: &mut CsvWriter,
+    summary: &mut Summary,
+    pts: &mut Vec<(f64, f64)>,
+    (knob, name, error_key): (&str, &str, &str),
+    secs: f64,
+    err: f64,
+) -> Result<()> {
+    csv.row(&[Cell::Text(knob.into()), Cell::Text(name.into()), 0.0.into(), (1e3 * secs).into(), err.into()])?;
+    summary.set(&format!("ms_per_frame_{name}"), 1e3 * secs);
+    summary.set(&format!("{error_key}_{name}"), err);
+    pts.push((1e3 * secs, err.max(1e-16)));
+    Ok(())
+}
+
 /// Runs the sweep.
 pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     let quads = if ctx.quick { 6 } else { 12 };
@@ -195,16 +212,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             ..Default::default()
         };
         let (secs, rep) = timed_frame(&rig, o, &def, min_t, AreaCheck::PerTriangle)?;
-        csv.row(&[
-            Cell::Text("mode".into()),
-            Cell::Text(name.into()),
-            0.0.into(),
-            (1e3 * secs).into(),
-            rep.mean_rel.into(),
-        ])?;
-        summary.set(&format!("ms_per_frame_{name}"), 1e3 * secs);
-        summary.set(&format!("area_residual_mean_{name}"), rep.mean_rel);
-        pts.push((1e3 * secs, rep.mean_rel.max(1e-16)));
+        record_frame(&mut csv, &mut summary, &mut pts, ("mode", name, "area_residual_mean"), secs, rep.mean_rel)?;
     }
     series.push(Series::new("mode (ms/frame)", pts));
     let mut pts = Vec::new();
@@ -220,16 +228,14 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             ..Default::default()
         };
         let (secs, rep) = timed_frame(&rig, o, &def, min_t, AreaCheck::Rendered { level: 2 })?;
-        csv.row(&[
-            Cell::Text("smoothing".into()),
-            Cell::Text(name.into()),
-            0.0.into(),
-            (1e3 * secs).into(),
-            rep.mean_rel.into(),
-        ])?;
-        summary.set(&format!("ms_per_frame_{name}"), 1e3 * secs);
-        summary.set(&format!("rendered_area_residual_mean_{name}"), rep.mean_rel);
-        pts.push((1e3 * secs, rep.mean_rel.max(1e-16)));
+        record_frame(
+            &mut csv,
+            &mut summary,
+            &mut pts,
+            ("smoothing", name, "rendered_area_residual_mean"),
+            secs,
+            rep.mean_rel,
+        )?;
     }
     series.push(Series::new("smoothing (ms/frame)", pts));
 
