@@ -14,18 +14,22 @@ pub mod cluster;
 #[cfg(feature = "parry")]
 pub mod collide;
 pub mod error;
+pub mod experiment;
 pub mod graph;
 pub mod image;
 pub mod io;
 pub mod iso;
+pub mod kinematic;
 pub mod linalg;
 pub mod math;
 pub mod mesh;
 pub mod procedural;
 pub mod query;
 pub mod raster;
+pub mod record;
 pub mod rng;
 pub mod spatial;
+pub mod stats;
 
 pub use error::{BvhError, Error, Result};
 pub use faer;

@@ -209,39 +209,7 @@ pub enum ObstacleShape {
     },
 }
 
-/// Rigid motion of an obstacle over time.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub enum KinematicPath {
-    /// Constant velocity (m/s).
-    Translate {
-        /// Velocity (m/s).
-        velocity: Vec3,
-    },
-    /// Constant angular velocity about an axis through a centre.
-    Rotate {
-        /// Point on the axis (m).
-        center: Pt3,
-        /// Axis (normalised on use).
-        axis: Vec3,
-        /// Angular speed (rad/s).
-        omega: f64,
-    },
-}
-
-impl KinematicPath {
-    /// The rigid transform at time t (s).
-    pub fn transform(&self, t: f64) -> geom_core::math::Iso3 {
-        use geom_core::math::{Iso3, UnitQuat};
-        match self {
-            KinematicPath::Translate { velocity } => Iso3::translation(velocity.x * t, velocity.y * t, velocity.z * t),
-            KinematicPath::Rotate { center, axis, omega } => {
-                let r = UnitQuat::from_axis_angle(&nalgebra::Unit::new_normalize(*axis), omega * t);
-                let c = center.coords;
-                Iso3::from_parts(nalgebra::Translation3::from(c - r * c), r)
-            }
-        }
-    }
-}
+pub use geom_core::kinematic::KinematicPath;
 
 /// A rigid (static or kinematic) obstacle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -16,6 +16,7 @@ mod error;
 mod inspect;
 mod out;
 mod plot;
+mod record;
 mod registry;
 mod report;
 mod run;

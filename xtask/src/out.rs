@@ -51,6 +51,18 @@ impl Summary {
         self
     }
 
+    /// Sets a signed integer.
+    pub fn set_int(&mut self, key: &str, v: i64) -> &mut Self {
+        self.values.insert(key.to_string(), serde_json::Value::from(v));
+        self
+    }
+
+    /// Sets a yes/no figure (`true` / `false`).
+    pub fn set_bool(&mut self, key: &str, v: bool) -> &mut Self {
+        self.values.insert(key.to_string(), serde_json::Value::from(v));
+        self
+    }
+
     /// Sets a text field (mode, units …).
     pub fn set_str(&mut self, key: &str, v: &str) -> &mut Self {
         self.values.insert(key.to_string(), serde_json::Value::from(v));

@@ -39,6 +39,17 @@ impl Mode {
         }
     }
 
+    /// The experiment size of geom-core this mode runs at.
+    #[allow(dead_code)] // used as the adapters move onto `record::run_experiment` (issue 21)
+    pub fn size(self) -> geom_core::experiment::Size {
+        use geom_core::experiment::Size;
+        match self {
+            Mode::Quick => Size::Quick,
+            Mode::Default => Size::Default,
+            Mode::Full => Size::Full,
+        }
+    }
+
     /// Picks one of three values by mode.
     pub fn pick<T>(self, quick: T, default: T, full: T) -> T {
         match self {
