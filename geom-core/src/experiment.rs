@@ -192,6 +192,9 @@ pub struct Report {
     pub figures: Vec<(String, Value)>,
     /// Checks of figures against targets.
     pub checks: Vec<Check>,
+    /// Keys of the figures that measure time or depend on it (wall times, rates, speed-ups,
+    /// thread counts): they differ from run to run and are left out of determinism checks.
+    pub timing: Vec<String>,
 }
 
 impl Report {
@@ -206,6 +209,26 @@ impl Report {
     /// Sets a measured number.
     pub fn num(&mut self, key: &str, v: f64) -> &mut Self {
         self.set(key, Value::Num(v))
+    }
+
+    /// Sets a figure that measures time or derives from it (s, rates, speed-ups, time ratios,
+    /// the thread count): excluded from reproducibility comparisons.
+    pub fn timing(&mut self, key: &str, v: f64) -> &mut Self {
+        if !self.timing.iter().any(|k| k == key) {
+            self.timing.push(key.to_string());
+        }
+        self.set(key, Value::Num(v))
+    }
+
+    /// True when `key` was set with [`Report::timing`].
+    pub fn is_timing(&self, key: &str) -> bool {
+        self.timing.iter().any(|k| k == key)
+    }
+
+    /// The figures that do not depend on timing, as `(key, value)`: what must be bitwise
+    /// identical across runs and thread counts.
+    pub fn reproducible_figures(&self) -> Vec<(String, Value)> {
+        self.figures.iter().filter(|(k, _)| !self.is_timing(k)).cloned().collect()
     }
 
     /// Sets a count.
@@ -250,7 +273,11 @@ impl Report {
     /// name).
     pub fn merge_prefixed(&mut self, prefix: &str, other: &Report) -> &mut Self {
         for (k, v) in &other.figures {
-            self.set(&format!("{prefix}{k}"), v.clone());
+            let key = format!("{prefix}{k}");
+            if other.is_timing(k) && !self.is_timing(&key) {
+                self.timing.push(key.clone());
+            }
+            self.set(&key, v.clone());
         }
         for c in &other.checks {
             let mut c = c.clone();
@@ -314,5 +341,11 @@ mod tests {
         a.merge_prefixed("linen_", &b);
         assert_eq!(a.get_f64("linen_err"), 0.1);
         assert_eq!(a.checks[0].key, "linen_err");
+        let mut t = Report::default();
+        t.timing("wall_s", 1.0).num("err", 0.5);
+        assert!(t.is_timing("wall_s") && !t.is_timing("err"));
+        assert_eq!(t.reproducible_figures(), vec![("err".to_string(), Value::Num(0.5))]);
+        a.merge_prefixed("x_", &t);
+        assert!(a.is_timing("x_wall_s"));
     }
 }
