@@ -676,7 +676,12 @@ impl ShellSim {
         for &(i, p) in targets.iter() {
             dx[i as usize] = p - qk[i as usize];
         }
-        let a_pin = if dx.iter().any(|d| *d != Vec3::zeros()) { ipc.max_step(&qk, &dx) } else { 1.0 };
+        let a_pin = if dx.iter().any(|d| *d != Vec3::zeros()) {
+            ipc.sweep(&qk, Some(&dx));
+            ipc.max_step(&qk, &dx)
+        } else {
+            1.0
+        };
         let mut x: Vec<Pt3> = qk.iter().zip(&dx).map(|(p, d)| p + a_pin * d).collect();
         if a_pin < 1.0 {
             st.contact.ccd_clamps += 1;
@@ -695,6 +700,7 @@ impl ShellSim {
             let i = vtx as usize;
             dx[i] = q_base[i] + h_eff * (v_cur[i] + h_eff * g) - x[i];
         }
+        ipc.sweep(&x, Some(&dx));
         let a_pred = ipc.max_step(&x, &dx);
         for &vtx in &free {
             let i = vtx as usize;
@@ -706,6 +712,8 @@ impl ShellSim {
         let nf = self.asm.dofs.n_free();
         let mut force = vec![Vec3::zeros(); n];
         let mut converged = false;
+        // Φ of the current iterate, carried over from the accepted trial of the last iteration.
+        let mut phi_cur: Option<f64> = None;
         for _ in 0..ipc.max_iters {
             let ta = Instant::now();
             for i in 0..n {
@@ -805,6 +813,7 @@ impl ShellSim {
             for (fidx, &vtx) in free.iter().enumerate() {
                 step_dx[vtx as usize] = h_eff * Vec3::new(dv[3 * fidx], dv[3 * fidx + 1], dv[3 * fidx + 2]);
             }
+            ipc.sweep(&x, Some(&step_dx));
             let mut a = ipc.max_step(&x, &step_dx);
             if a < 1.0 {
                 st.contact.ccd_clamps += 1;
@@ -819,15 +828,19 @@ impl ShellSim {
                 st.t_collision += tl.elapsed().as_secs_f64();
                 break;
             }
-            let phi0 = self.ipc_potential(ipc, q_base, h_eff, v_ref, v_cur, t_next, alpha);
+            let phi0 = match phi_cur {
+                Some(p) => p,
+                None => self.ipc_potential(ipc, q_base, h_eff, v_ref, v_cur, t_next, alpha),
+            };
             let mut trial = v_cur.to_vec();
             let mut accepted = false;
+            let mut phi = phi0;
             for _ in 0..30 {
                 for (fidx, &vtx) in free.iter().enumerate() {
                     let i = vtx as usize;
                     trial[i] = v_cur[i] + a * Vec3::new(dv[3 * fidx], dv[3 * fidx + 1], dv[3 * fidx + 2]);
                 }
-                let phi = self.ipc_potential(ipc, q_base, h_eff, v_ref, &trial, t_next, alpha);
+                phi = self.ipc_potential(ipc, q_base, h_eff, v_ref, &trial, t_next, alpha);
                 if phi <= phi0 {
                     accepted = true;
                     break;
@@ -841,6 +854,7 @@ impl ShellSim {
                 st.contact.line_search_failures += 1;
             }
             v_cur.copy_from_slice(&trial);
+            phi_cur = Some(phi);
             if std::env::var_os("SHELLS_IPC_DEBUG").is_some() {
                 eprintln!(
                     "  iter {}: |dv| {dv_max:.3e} alpha {a:.3e} contacts {} phi0 {phi0:.6e}",
@@ -872,16 +886,7 @@ impl ShellSim {
     /// Φ(v) of the IPC line search: the incremental potential of [`ShellSim::incremental_potential`]
     /// plus mass damping ½hα·Σm|v|² and contact (barrier + lagged friction) energy.
     #[allow(clippy::too_many_arguments)]
-    fn ipc_potential(
-        &self,
-        ipc: &mut Ipc,
-        q_base: &[Pt3],
-        h: f64,
-        v_ref: &[Vec3],
-        v: &[Vec3],
-        t: f64,
-        alpha: f64,
-    ) -> f64 {
+    fn ipc_potential(&self, ipc: &Ipc, q_base: &[Pt3], h: f64, v_ref: &[Vec3], v: &[Vec3], t: f64, alpha: f64) -> f64 {
         let q: Vec<Pt3> = q_base.iter().zip(v).map(|(p, vv)| p + h * vv).collect();
         let damp: f64 = if alpha > 0.0 {
             0.5 * h
@@ -928,6 +933,25 @@ impl ShellSim {
         let mut st = StepStats::default();
         let mut v: Vec<Vec3> =
             (0..n).map(|i| if self.inv_mass[i] > 0.0 { v_new[i] } else { self.state.v[i] }).collect();
+        if let Some(ipc) = self.ipc.as_mut() {
+            // IPC: from the (collision-free) end of the step toward q_k + h·v, as far as CCD
+            // allows — contact keeps priority, and no gap closes below its CCD fraction.
+            let tc = Instant::now();
+            let x = &self.state.q;
+            let dx: Vec<Vec3> =
+                (0..n).map(|i| if self.inv_mass[i] > 0.0 { qk[i] + h * v[i] - x[i] } else { Vec3::zeros() }).collect();
+            ipc.sweep(x, Some(&dx));
+            let a = ipc.max_step(x, &dx);
+            if a < 1.0 {
+                st.contact.ccd_clamps += 1;
+            }
+            for i in 0..n {
+                if self.inv_mass[i] > 0.0 {
+                    v[i] = (x[i] + a * dx[i] - qk[i]) / h;
+                }
+            }
+            st.t_collision = tc.elapsed().as_secs_f64();
+        }
         if let Some(col) = self.collider.as_mut() {
             let tc = Instant::now();
             col.filter(qk, &mut v, h, t_next, &self.inv_mass, &mut st);

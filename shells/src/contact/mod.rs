@@ -77,6 +77,8 @@ pub(crate) struct Ipc {
     /// Newton iteration cap.
     pub max_iters: u32,
     bp: BroadPhase,
+    /// Candidate pairs of the last [`Ipc::sweep`].
+    cands: Option<Cands>,
     friction: Vec<FrictionContact>,
     x0: Vec<Pt3>,
     eps: f64,
@@ -120,6 +122,7 @@ impl Ipc {
             newton_tol: cs.newton_tol,
             max_iters: cs.max_newton_iters,
             bp: BroadPhase::default(),
+            cands: None,
             friction: Vec::new(),
             x0: Vec::new(),
             eps: 0.0,
@@ -141,6 +144,7 @@ impl Ipc {
             .collect();
         self.x0 = x0.to_vec();
         self.eps = self.eps_v * h;
+        self.sweep(x0, None);
         let contacts = self.contacts(x0);
         let mut bad = 0u32;
         let mut fr = Vec::new();
@@ -178,27 +182,74 @@ impl Ipc {
         Ok(self.friction.len() as u32)
     }
 
-    /// The contact set at `x` (pairs closer than d̂), sorted by key.
-    pub(crate) fn contacts(&mut self, x: &[Pt3]) -> Vec<Contact> {
-        let dhat = self.dhat;
-        let (vb, eb, tb) = set::boxes(x, None, &self.tris, &self.edges, 0.5 * dhat);
+    /// Finds, with one broad phase, every pair that may come within d̂ anywhere on the straight
+    /// motion x → x + dx (at x when `dx` is `None`): the candidates that [`Ipc::contacts`] and
+    /// [`Ipc::max_step`] then test for any configuration on that segment. One sweep per Newton
+    /// iteration serves the CCD bound, every line-search trial and the next iteration's contact
+    /// set (the accepted iterate lies on the segment).
+    pub(crate) fn sweep(&mut self, x: &[Pt3], dx: Option<&[Vec3]>) {
         let topo = Topo { tris: &self.tris, edges: &self.edges, mean_edge: self.mean_edge, mu_self: self.mu_self };
-        let mut all = Vec::new();
-        if self.self_collision {
-            let (vt, ee) = set::self_candidates(&mut self.bp, &topo, &vb, &eb, &tb);
-            all = set::self_contacts(&topo, x, &vt, &ee, dhat);
-        }
-        if !self.placed.is_empty() {
-            let (vb, eb, tb) = set::boxes(x, None, &self.tris, &self.edges, dhat);
-            for (o, (p, ob)) in self.placed.iter().zip(&self.obstacles).enumerate() {
-                all.extend(set::obstacle_contacts(&topo, x, o as u32, p, ob.friction, &vb, &eb, &tb, dhat));
-            }
+        let (mut vt, mut ee) = if self.self_collision {
+            let (vb, eb, tb) = set::boxes(x, dx, &self.tris, &self.edges, 0.5 * self.dhat);
+            set::self_candidates(&mut self.bp, &topo, &vb, &eb, &tb)
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        // Keep only pairs that can come within d̂ on the segment: the distance at x minus the
+        // most the pair can approach (the largest displacement of each side) — boxes of a flat
+        // grid overlap far more pairs than are close (a diagonal's box covers its neighbours).
+        let moved = |i: u32| dx.map_or(0.0, |d| d[i as usize].norm());
+        let side = |ids: &[u32]| ids.iter().map(|&i| moved(i)).fold(0.0, f64::max);
+        let dhat = self.dhat;
+        let (tris, edges) = (&self.tris, &self.edges);
+        vt = vt
+            .into_par_iter()
+            .with_min_len(1024)
+            .filter(|&(v, t)| {
+                let tri = tris[t as usize];
+                let d = pt_d2(&[x[v as usize], x[tri[0] as usize], x[tri[1] as usize], x[tri[2] as usize]]).sqrt();
+                d - moved(v) - side(&tri) < dhat
+            })
+            .collect();
+        ee = ee
+            .into_par_iter()
+            .with_min_len(1024)
+            .filter(|&(e, f)| {
+                let (a, b) = (edges[e as usize], edges[f as usize]);
+                let d = ee_d2(&[x[a[0] as usize], x[a[1] as usize], x[b[0] as usize], x[b[1] as usize]]).sqrt();
+                d - side(&a) - side(&b) < dhat
+            })
+            .collect();
+        let obs = if self.placed.iter().any(|p| matches!(p, Placed::Core(_))) {
+            let (vb, eb, tb) = set::boxes(x, dx, &self.tris, &self.edges, self.dhat);
+            self.placed
+                .iter()
+                .map(|p| match p {
+                    Placed::Core(c) => set::core_candidates(&topo, c, &vb, &eb, &tb),
+                    Placed::Half { .. } => set::CoreCands::default(),
+                })
+                .collect()
+        } else {
+            vec![set::CoreCands::default(); self.placed.len()]
+        };
+        self.cands = Some(Cands { vt, ee, obs });
+    }
+
+    /// The contact set at `x` (pairs closer than d̂), sorted by key, from the candidates of
+    /// the last [`Ipc::sweep`] (whose segment must contain `x`).
+    pub(crate) fn contacts(&self, x: &[Pt3]) -> Vec<Contact> {
+        let dhat = self.dhat;
+        let topo = Topo { tris: &self.tris, edges: &self.edges, mean_edge: self.mean_edge, mu_self: self.mu_self };
+        let Some(c) = self.cands.as_ref() else { return Vec::new() };
+        let mut all = if self.self_collision { set::self_contacts(&topo, x, &c.vt, &c.ee, dhat) } else { Vec::new() };
+        for (o, ((p, ob), oc)) in self.placed.iter().zip(&self.obstacles).zip(&c.obs).enumerate() {
+            all.extend(set::obstacle_contacts(&topo, x, o as u32, p, oc, ob.friction, dhat));
         }
         set::dedup(all)
     }
 
     /// Barrier and friction energy at `x` (J): κΣb(d) + ΣD; +∞ if a gap is ≤ 0.
-    pub(crate) fn energy(&mut self, x: &[Pt3]) -> f64 {
+    pub(crate) fn energy(&self, x: &[Pt3]) -> f64 {
         let c = self.contacts(x);
         let (kappa, dhat) = (self.kappa, self.dhat);
         let b: f64 = c.iter().map(|c| kappa * barrier::value(c.gap(x).d, dhat)).sum();
@@ -276,18 +327,13 @@ impl Ipc {
     }
 
     /// The largest α ∈ (0, 1] such that the straight motion x → x + α·dx keeps every gap above
-    /// [`CCD_KEEP`] of its value (additive CCD over the swept-box candidates).
-    pub(crate) fn max_step(&mut self, x: &[Pt3], dx: &[Vec3]) -> f64 {
-        // Swept boxes grown like the active set's: every pair that may end closer than d̂ is
-        // tested, so no gap can shrink below CCD_KEEP of its value unseen.
-        let (vb, eb, tb) = set::boxes(x, Some(dx), &self.tris, &self.edges, 0.5 * self.dhat);
-        let topo = Topo { tris: &self.tris, edges: &self.edges, mean_edge: self.mean_edge, mu_self: self.mu_self };
-        let mut alpha: f64 = 1.0;
-        if self.self_collision {
-            let (vt, ee) = set::self_candidates(&mut self.bp, &topo, &vb, &eb, &tb);
-            let (tris, edges) = (&self.tris, &self.edges);
-            let a_vt = vt
-                .par_iter()
+    /// [`CCD_KEEP`] of its value (additive CCD over the candidates of the last
+    /// [`Ipc::sweep`], which must have been of this very segment).
+    pub(crate) fn max_step(&self, x: &[Pt3], dx: &[Vec3]) -> f64 {
+        let Some(c) = self.cands.as_ref() else { return 1.0 };
+        let (tris, edges) = (&self.tris, &self.edges);
+        let a_vt =
+            c.vt.par_iter()
                 .with_min_len(512)
                 .map(|&(v, t)| {
                     let tri = tris[t as usize];
@@ -295,8 +341,8 @@ impl Ipc {
                     toi4(&ids.map(|i| x[i as usize]), &ids.map(|i| dx[i as usize]), 1, pt_d2, 0.0)
                 })
                 .reduce(|| 1.0, f64::min);
-            let a_ee = ee
-                .par_iter()
+        let a_ee =
+            c.ee.par_iter()
                 .with_min_len(512)
                 .map(|&(e, f)| {
                     let (a, b) = (edges[e as usize], edges[f as usize]);
@@ -304,13 +350,9 @@ impl Ipc {
                     toi4(&ids.map(|i| x[i as usize]), &ids.map(|i| dx[i as usize]), 2, ee_d2, 0.0)
                 })
                 .reduce(|| 1.0, f64::min);
-            alpha = alpha.min(a_vt).min(a_ee);
-        }
-        if !self.placed.is_empty() {
-            let (vb, eb, tb) = set::boxes(x, Some(dx), &self.tris, &self.edges, self.dhat);
-            for p in &self.placed {
-                alpha = alpha.min(obstacle_toi(p, x, dx, &self.tris, &self.edges, self.mean_edge, &vb, &eb, &tb));
-            }
+        let mut alpha = a_vt.min(a_ee);
+        for (p, oc) in self.placed.iter().zip(&c.obs) {
+            alpha = alpha.min(obstacle_toi(p, oc, x, dx, tris, edges));
         }
         alpha
     }
@@ -342,18 +384,7 @@ fn toi4(x: &[Pt3; 4], dx: &[Vec3; 4], split: usize, d2: fn(&[Pt3; 4]) -> f64, xi
 }
 
 /// Step bound from one placed obstacle (fixed during the step's Newton iterations).
-#[allow(clippy::too_many_arguments)]
-fn obstacle_toi(
-    p: &Placed,
-    x: &[Pt3],
-    dx: &[Vec3],
-    tris: &[[u32; 3]],
-    edges: &[[u32; 2]],
-    mean_edge: f64,
-    vb: &[geom_core::spatial::Aabb],
-    eb: &[geom_core::spatial::Aabb],
-    tb: &[geom_core::spatial::Aabb],
-) -> f64 {
+fn obstacle_toi(p: &Placed, c: &set::CoreCands, x: &[Pt3], dx: &[Vec3], tris: &[[u32; 3]], edges: &[[u32; 2]]) -> f64 {
     match p {
         Placed::Half { normal, offset } => x
             .par_iter()
@@ -372,59 +403,39 @@ fn obstacle_toi(
             })
             .reduce(|| 1.0, f64::min),
         Placed::Core(core) => {
-            let [pt_tree, e_tree, t_tree] = &core.trees;
             let z = Vec3::zeros();
+            let pt = |i: u32| core.points[i as usize];
             let mut alpha: f64 = 1.0;
-            if !core.tris.is_empty() {
-                for (v, b) in vb.iter().enumerate() {
-                    t_tree.query(b, |t| {
-                        let ot = core.tris[t as usize];
-                        let y = [
-                            x[v],
-                            core.points[ot[0] as usize],
-                            core.points[ot[1] as usize],
-                            core.points[ot[2] as usize],
-                        ];
-                        alpha = alpha.min(toi4(&y, &[dx[v], z, z, z], 1, pt_d2, core.xi));
-                    });
-                }
+            for &(v, t) in &c.v_ot {
+                let (v, ot) = (v as usize, core.tris[t as usize]);
+                let y = [x[v], pt(ot[0]), pt(ot[1]), pt(ot[2])];
+                alpha = alpha.min(toi4(&y, &[dx[v], z, z, z], 1, pt_d2, core.xi));
             }
-            if !core.edges.is_empty() {
-                for (e, b) in eb.iter().enumerate() {
-                    let a = edges[e];
-                    e_tree.query(b, |f| {
-                        let ob = core.edges[f as usize];
-                        let y = [
-                            x[a[0] as usize],
-                            x[a[1] as usize],
-                            core.points[ob[0] as usize],
-                            core.points[ob[1] as usize],
-                        ];
-                        alpha = alpha.min(toi4(&y, &[dx[a[0] as usize], dx[a[1] as usize], z, z], 2, ee_d2, core.xi));
-                    });
-                }
+            for &(e, f) in &c.e_oe {
+                let (a, ob) = (edges[e as usize], core.edges[f as usize]);
+                let y = [x[a[0] as usize], x[a[1] as usize], pt(ob[0]), pt(ob[1])];
+                alpha = alpha.min(toi4(&y, &[dx[a[0] as usize], dx[a[1] as usize], z, z], 2, ee_d2, core.xi));
             }
-            if core.tris.is_empty() {
-                for (v, b) in vb.iter().enumerate() {
-                    pt_tree.query(b, |q| {
-                        let y = [x[v], core.points[q as usize]];
-                        let pp = |y: &[Pt3; 2]| (y[0] - y[1]).norm_squared();
-                        let t = accd::time_of_impact(&y, &[dx[v], z], 1, pp, core.xi, CCD_KEEP, 1.0);
-                        alpha = alpha.min(t.unwrap_or(1.0));
-                    });
-                }
+            for &(v, q) in &c.v_op {
+                let v = v as usize;
+                let pp = |y: &[Pt3; 2]| (y[0] - y[1]).norm_squared();
+                let t = accd::time_of_impact(&[x[v], pt(q)], &[dx[v], z], 1, pp, core.xi, CCD_KEEP, 1.0);
+                alpha = alpha.min(t.unwrap_or(1.0));
             }
-            // The same rule as the contact set (`set::core_contacts`).
-            let faces = !core.tris.is_empty() || core.xi <= mean_edge;
-            for (t, b) in tb.iter().enumerate().filter(|_| faces) {
-                let tri = tris[t];
-                pt_tree.query(b, |q| {
-                    let y = [core.points[q as usize], x[tri[0] as usize], x[tri[1] as usize], x[tri[2] as usize]];
-                    let d = [z, dx[tri[0] as usize], dx[tri[1] as usize], dx[tri[2] as usize]];
-                    alpha = alpha.min(toi4(&y, &d, 1, pt_d2, core.xi));
-                });
+            for &(t, q) in &c.t_op {
+                let tri = tris[t as usize];
+                let y = [pt(q), x[tri[0] as usize], x[tri[1] as usize], x[tri[2] as usize]];
+                let d = [z, dx[tri[0] as usize], dx[tri[1] as usize], dx[tri[2] as usize]];
+                alpha = alpha.min(toi4(&y, &d, 1, pt_d2, core.xi));
             }
             alpha
         }
     }
+}
+
+/// Candidate pairs of one sweep.
+struct Cands {
+    vt: Vec<(u32, u32)>,
+    ee: Vec<(u32, u32)>,
+    obs: Vec<set::CoreCands>,
 }

@@ -224,6 +224,16 @@ fn edge_edge(
     Some(Contact { key, form, nodes, xi, mu, obstacle })
 }
 
+/// True when the point sets are farther apart than `d` along some coordinate axis (then no
+/// two of their convex hulls' points are within `d`): a cheap rejection before closest points.
+fn far(a: &[Pt3], b: &[Pt3], d: f64) -> bool {
+    (0..3).any(|k| {
+        let (amin, amax) = a.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |m, p| (m.0.min(p[k]), m.1.max(p[k])));
+        let (bmin, bmax) = b.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |m, p| (m.0.min(p[k]), m.1.max(p[k])));
+        amin - bmax > d || bmin - amax > d
+    })
+}
+
 /// Self-contacts of the candidate pairs at `x` closer than d̂.
 pub(crate) fn self_contacts(topo: &Topo, x: &[Pt3], vt: &[(u32, u32)], ee: &[(u32, u32)], dhat: f64) -> Vec<Contact> {
     let (tris, edges, mu) = (topo.tris, topo.edges, topo.mu_self);
@@ -233,6 +243,9 @@ pub(crate) fn self_contacts(topo: &Topo, x: &[Pt3], vt: &[(u32, u32)], ee: &[(u3
         .filter_map(|&(v, t)| {
             let tri = tris[t as usize];
             let tp = tri.map(|i| x[i as usize]);
+            if far(&[x[v as usize]], &tp, dhat) {
+                return None;
+            }
             let tf = |k: PtKind| match k {
                 PtKind::Face => Feat::T(t),
                 PtKind::Edge(k) => Feat::E(edge_id(edges, tri[k as usize], tri[(k as usize + 1) % 3])),
@@ -243,6 +256,9 @@ pub(crate) fn self_contacts(topo: &Topo, x: &[Pt3], vt: &[(u32, u32)], ee: &[(u3
         .collect();
     out.par_extend(ee.par_iter().with_min_len(1024).filter_map(|&(e, f)| {
         let (a, b) = (edges[e as usize], edges[f as usize]);
+        if far(&a.map(|i| x[i as usize]), &b.map(|i| x[i as usize]), dhat) {
+            return None;
+        }
         let af = |i: Option<u8>| i.map_or(Feat::E(e), |i| Feat::V(a[i as usize]));
         let bf = |j: Option<u8>| j.map_or(Feat::E(f), |j| Feat::V(b[j as usize]));
         edge_edge(
@@ -261,18 +277,59 @@ pub(crate) fn self_contacts(topo: &Topo, x: &[Pt3], vt: &[(u32, u32)], ee: &[(u3
     out
 }
 
-/// Contacts of the cloth at `x` with obstacle `o` (placed), boxes of cloth primitives given
-/// (already grown by d̂ for the active set, or swept for CCD candidates).
+/// Candidate pairs of the cloth with one core obstacle: cloth vertex × obstacle triangle, cloth
+/// edge × obstacle edge, cloth triangle × obstacle point, cloth vertex × obstacle point.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct CoreCands {
+    pub v_ot: Vec<(u32, u32)>,
+    pub e_oe: Vec<(u32, u32)>,
+    pub t_op: Vec<(u32, u32)>,
+    pub v_op: Vec<(u32, u32)>,
+}
+
+/// Every pair the contact set or the CCD may need for one obstacle, from the boxes of the
+/// cloth's primitives (grown by d̂, swept over a step) against the obstacle's trees (boxes
+/// grown by ξ). Which pair kinds a core obstacle gets: meshes their vertices × triangles, edges
+/// × edges and triangles × vertices; round obstacles (sphere, capsule) edges × axis and
+/// vertices × core points, plus triangles × core points only when the radius is at most the
+/// cloth's mean edge. A large sphere is met by vertices and edges: its face contacts would
+/// measure the distance to a plane from a centre far beyond the triangle (a lever of r/ℓ² in
+/// the curvature that the Gauss–Newton Hessian misses; Newton then crawls), while the sagitta
+/// ℓ²/8r a triangle can dip between its vertices stays far below d̂.
+pub(crate) fn core_candidates(topo: &Topo, core: &Core, vb: &[Aabb], eb: &[Aabb], tb: &[Aabb]) -> CoreCands {
+    let [pt_tree, e_tree, t_tree] = &core.trees;
+    let mut c = CoreCands::default();
+    if !core.tris.is_empty() {
+        for (v, b) in vb.iter().enumerate() {
+            t_tree.query(b, |t| c.v_ot.push((v as u32, t)));
+        }
+    } else {
+        for (v, b) in vb.iter().enumerate() {
+            pt_tree.query(b, |p| c.v_op.push((v as u32, p)));
+        }
+    }
+    if !core.edges.is_empty() {
+        for (e, b) in eb.iter().enumerate() {
+            e_tree.query(b, |f| c.e_oe.push((e as u32, f)));
+        }
+    }
+    if !core.tris.is_empty() || core.xi <= topo.mean_edge {
+        for (t, b) in tb.iter().enumerate() {
+            pt_tree.query(b, |p| c.t_op.push((t as u32, p)));
+        }
+    }
+    c
+}
+
+/// Contacts of the cloth at `x` with obstacle `o` closer than d̂, from its candidates.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn obstacle_contacts(
     topo: &Topo,
     x: &[Pt3],
     o: u32,
     placed: &Placed,
+    cands: &CoreCands,
     mu: f64,
-    vbox: &[Aabb],
-    ebox: &[Aabb],
-    tbox: &[Aabb],
     dhat: f64,
 ) -> Vec<Contact> {
     match placed {
@@ -287,129 +344,76 @@ pub(crate) fn obstacle_contacts(
                 obstacle: o,
             })
             .collect(),
-        Placed::Core(core) => core_contacts(topo, x, o, core, mu, vbox, ebox, tbox, dhat),
+        Placed::Core(core) => core_contacts(topo, x, o, core, cands, mu, dhat),
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn core_contacts(
-    topo: &Topo,
-    x: &[Pt3],
-    o: u32,
-    core: &Core,
-    mu: f64,
-    vbox: &[Aabb],
-    ebox: &[Aabb],
-    tbox: &[Aabb],
-    dhat: f64,
-) -> Vec<Contact> {
+fn core_contacts(topo: &Topo, x: &[Pt3], o: u32, core: &Core, c: &CoreCands, mu: f64, dhat: f64) -> Vec<Contact> {
     let (tris, edges) = (topo.tris, topo.edges);
-    let [pt_tree, e_tree, t_tree] = &core.trees;
     let xi = core.xi;
     let fixed = |i: u32| Node::Fixed(core.points[i as usize]);
     let mut out = Vec::new();
-    // Cloth vertex × obstacle triangle.
-    if !core.tris.is_empty() {
-        for (v, b) in vbox.iter().enumerate() {
-            let v = v as u32;
-            t_tree.query(b, |t| {
-                let ot = core.tris[t as usize];
-                let tp = ot.map(|i| core.points[i as usize]);
-                let tf = |k: PtKind| match k {
-                    PtKind::Face => Feat::OT(o, t),
-                    PtKind::Edge(k) => Feat::OE(o, edge_id(&core.edges, ot[k as usize], ot[(k as usize + 1) % 3])),
-                    PtKind::Vertex(k) => Feat::OP(o, ot[k as usize]),
-                };
-                out.extend(point_tri(
-                    &x[v as usize],
-                    &tp,
-                    Node::Cloth(v),
-                    Feat::V(v),
-                    ot.map(fixed),
-                    tf,
-                    xi,
-                    dhat,
-                    mu,
-                    o,
-                ));
+    for &(v, t) in &c.v_ot {
+        let ot = core.tris[t as usize];
+        let tp = ot.map(|i| core.points[i as usize]);
+        let tf = |k: PtKind| match k {
+            PtKind::Face => Feat::OT(o, t),
+            PtKind::Edge(k) => Feat::OE(o, edge_id(&core.edges, ot[k as usize], ot[(k as usize + 1) % 3])),
+            PtKind::Vertex(k) => Feat::OP(o, ot[k as usize]),
+        };
+        out.extend(point_tri(&x[v as usize], &tp, Node::Cloth(v), Feat::V(v), ot.map(fixed), tf, xi, dhat, mu, o));
+    }
+    for &(e, f) in &c.e_oe {
+        let a = edges[e as usize];
+        let ob = core.edges[f as usize];
+        let af = |i: Option<u8>| i.map_or(Feat::E(e), |i| Feat::V(a[i as usize]));
+        let bf = |j: Option<u8>| j.map_or(Feat::OE(o, f), |j| Feat::OP(o, ob[j as usize]));
+        out.extend(edge_edge(
+            [&x[a[0] as usize], &x[a[1] as usize]],
+            [&core.points[ob[0] as usize], &core.points[ob[1] as usize]],
+            a.map(Node::Cloth),
+            ob.map(fixed),
+            af,
+            bf,
+            xi,
+            dhat,
+            mu,
+            o,
+        ));
+    }
+    for &(v, p) in &c.v_op {
+        let (x0, cp) = (x[v as usize], core.points[p as usize]);
+        if (x0 - cp).norm() - xi < dhat {
+            out.push(Contact {
+                key: vv(Feat::V(v), Feat::OP(o, p)),
+                form: Form::PointPoint,
+                nodes: [Node::Cloth(v), fixed(p), Node::Unused, Node::Unused],
+                xi,
+                mu,
+                obstacle: o,
             });
         }
     }
-    // Cloth edge × obstacle edge.
-    if !core.edges.is_empty() {
-        for (e, b) in ebox.iter().enumerate() {
-            let e = e as u32;
-            let a = edges[e as usize];
-            e_tree.query(b, |f| {
-                let ob = core.edges[f as usize];
-                let af = |i: Option<u8>| i.map_or(Feat::E(e), |i| Feat::V(a[i as usize]));
-                let bf = |j: Option<u8>| j.map_or(Feat::OE(o, f), |j| Feat::OP(o, ob[j as usize]));
-                out.extend(edge_edge(
-                    [&x[a[0] as usize], &x[a[1] as usize]],
-                    [&core.points[ob[0] as usize], &core.points[ob[1] as usize]],
-                    a.map(Node::Cloth),
-                    ob.map(fixed),
-                    af,
-                    bf,
-                    xi,
-                    dhat,
-                    mu,
-                    o,
-                ));
-            });
-        }
-    }
-    // Cloth vertex × obstacle point, for round obstacles: a vertex against a sphere's centre or
-    // a capsule's end (meshes get their point contacts from the triangle pairs above).
-    if core.tris.is_empty() {
-        for (v, b) in vbox.iter().enumerate() {
-            let v = v as u32;
-            pt_tree.query(b, |p| {
-                let (x0, c) = (x[v as usize], core.points[p as usize]);
-                if (x0 - c).norm() - xi < dhat {
-                    out.push(Contact {
-                        key: vv(Feat::V(v), Feat::OP(o, p)),
-                        form: Form::PointPoint,
-                        nodes: [Node::Cloth(v), fixed(p), Node::Unused, Node::Unused],
-                        xi,
-                        mu,
-                        obstacle: o,
-                    });
-                }
-            });
-        }
-    }
-    // Cloth triangle × obstacle point: mesh corners poking into the cloth, and round obstacles
-    // no wider than the cloth's triangles. A large sphere is met by vertices and edges only:
-    // its face contacts would measure the distance to a plane from a centre far beyond the
-    // triangle (a lever of r/ℓ² in the curvature that the Gauss–Newton Hessian misses; Newton
-    // then crawls), while the sagitta ℓ²/8r a triangle can dip between its vertices stays
-    // far below d̂.
-    if !core.tris.is_empty() || xi <= topo.mean_edge {
-        for (t, b) in tbox.iter().enumerate() {
-            let t = t as u32;
-            let tri = tris[t as usize];
-            pt_tree.query(b, |p| {
-                let tp = tri.map(|i| x[i as usize]);
-                let tf = |k: PtKind| match k {
-                    PtKind::Face => Feat::T(t),
-                    PtKind::Edge(k) => Feat::E(edge_id(edges, tri[k as usize], tri[(k as usize + 1) % 3])),
-                    PtKind::Vertex(k) => Feat::V(tri[k as usize]),
-                };
-                out.extend(point_tri(
-                    &core.points[p as usize],
-                    &tp,
-                    fixed(p),
-                    Feat::OP(o, p),
-                    tri.map(Node::Cloth),
-                    tf,
-                    xi,
-                    dhat,
-                    mu,
-                    o,
-                ));
-            });
-        }
+    for &(t, p) in &c.t_op {
+        let tri = tris[t as usize];
+        let tp = tri.map(|i| x[i as usize]);
+        let tf = |k: PtKind| match k {
+            PtKind::Face => Feat::T(t),
+            PtKind::Edge(k) => Feat::E(edge_id(edges, tri[k as usize], tri[(k as usize + 1) % 3])),
+            PtKind::Vertex(k) => Feat::V(tri[k as usize]),
+        };
+        out.extend(point_tri(
+            &core.points[p as usize],
+            &tp,
+            fixed(p),
+            Feat::OP(o, p),
+            tri.map(Node::Cloth),
+            tf,
+            xi,
+            dhat,
+            mu,
+            o,
+        ));
     }
     out
 }
