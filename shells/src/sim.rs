@@ -818,6 +818,12 @@ impl ShellSim {
             if a < 1.0 {
                 st.contact.ccd_clamps += 1;
             }
+            if a == 0.0 {
+                // Blocked: a pair at the gap floor would close further (a conflict that keeps
+                // pushing, e.g. a tracking constraint into an obstacle): contact wins.
+                st.t_collision += tl.elapsed().as_secs_f64();
+                break;
+            }
             if dv_max <= ipc.newton_tol {
                 // Converged: take the (CCD-safe) step without a line search.
                 for (fidx, &vtx) in free.iter().enumerate() {

@@ -15,11 +15,15 @@ use geom_core::math::{Pt3, Vec3};
 /// contacts (tangential motion much larger than the gap) need many small advances.
 const MAX_ITERS: usize = 10_000;
 
-/// The first time t ∈ [0, t_max] at which the gap of the pair may drop below `s`·(its value at
-/// t = 0), or `None` when it stays above over [0, t_max]. `x`: the pair's points at t = 0,
-/// `p`: their displacements over t ∈ [0, 1], `split`: how many of them belong to the first
-/// primitive, `dist2`: the squared distance of the primitives, `xi`: the thickness subtracted
-/// from the distance (m), `s ∈ (0, 1)`: the fraction of the gap that must remain.
+/// The first time t ∈ [0, t_max] at which the gap of the pair may drop below
+/// max(`s`·g₀, `floor`) (g₀ its value at t = 0), or `None` when it stays above over [0, t_max].
+/// `x`: the pair's points at t = 0, `p`: their displacements over t ∈ [0, 1], `split`: how many
+/// of them belong to the first primitive, `dist2`: the squared distance of the primitives,
+/// `xi`: the thickness subtracted from the distance (m), `s ∈ (0, 1)`: the fraction of the gap
+/// that must remain, `floor` (m): an absolute gap no motion may go below — a pair already at
+/// or below it may only move apart (it gets t = 0 if its gap starts to shrink), so a conflict
+/// that keeps pushing (a hard constraint into an obstacle) cannot drive a gap to zero.
+#[allow(clippy::too_many_arguments)]
 pub fn time_of_impact<const K: usize>(
     x: &[Pt3; K],
     p: &[Vec3; K],
@@ -27,6 +31,7 @@ pub fn time_of_impact<const K: usize>(
     dist2: impl Fn(&[Pt3; K]) -> f64,
     xi: f64,
     s: f64,
+    floor: f64,
     t_max: f64,
 ) -> Option<f64> {
     let mean: Vec3 = p.iter().sum::<Vec3>() / K as f64;
@@ -41,9 +46,15 @@ pub fn time_of_impact<const K: usize>(
     if lp == 0.0 {
         return None;
     }
-    let target = s * g0;
+    if g0 <= floor {
+        // Only separation is allowed: the gap after a tiny part of the motion tells.
+        let tiny = 1e-6 * t_max;
+        let y: [Pt3; K] = std::array::from_fn(|k| x[k] + tiny * rel[k]);
+        return if dist2(&y).sqrt() - xi < g0 { Some(0.0) } else { None };
+    }
+    let target = (s * g0).max(floor);
     let mut t = 0.0;
-    let mut tl = (1.0 - s) * g0 / lp;
+    let mut tl = (g0 - target) / lp;
     let mut y = *x;
     for _ in 0..MAX_ITERS {
         for k in 0..K {
@@ -80,25 +91,38 @@ mod tests {
         // Two points 1 m apart closing at 2 m per unit time: contact at t = 0.5.
         let x = [Pt3::new(0.0, 0.0, 0.0), Pt3::new(1.0, 0.0, 0.0)];
         let p = [Vec3::new(1.0, 0.0, 0.0), Vec3::new(-1.0, 0.0, 0.0)];
-        let t = time_of_impact(&x, &p, 1, pp, 0.0, 0.1, 1.0).expect("they meet");
+        let t = time_of_impact(&x, &p, 1, pp, 0.0, 0.1, 0.0, 1.0).expect("they meet");
         // The gap at t is ≥ 0.1 and the search stops once it is below 0.1·(1/0.9)-ish.
         let gap = 1.0 - 2.0 * t;
         assert!(gap >= 0.1 - 1e-12 && gap < 0.2, "t = {t}, gap = {gap}");
         // With thickness 0.5 the gap is 0.5 and closes at t = 0.25.
-        let t = time_of_impact(&x, &p, 1, pp, 0.5, 0.1, 1.0).expect("they meet");
+        let t = time_of_impact(&x, &p, 1, pp, 0.5, 0.1, 0.0, 1.0).expect("they meet");
         assert!(1.0 - 2.0 * t - 0.5 >= 0.05 - 1e-12 && t < 0.25);
+    }
+
+    #[test]
+    fn the_floor_holds_a_pushed_pair_and_lets_it_separate() {
+        let x = [Pt3::new(0.0, 0.0, 0.0), Pt3::new(1.0, 0.0, 0.0)];
+        let closing = [Vec3::new(0.45, 0.0, 0.0), Vec3::new(-0.45, 0.0, 0.0)];
+        // Gap 1, floor 0.5: may close to 0.5 at most (t ≤ 0.5/0.9).
+        let t = time_of_impact(&x, &closing, 1, pp, 0.0, 0.1, 0.5, 1.0).expect("stopped by the floor");
+        assert!(1.0 - 0.9 * t >= 0.5 - 1e-12 && t > 0.3, "t = {t}");
+        // At the floor: no closing at all, separating is free.
+        assert_eq!(time_of_impact(&x, &closing, 1, pp, 0.0, 0.1, 1.0, 1.0), Some(0.0));
+        let opening = [Vec3::new(-0.45, 0.0, 0.0), Vec3::new(0.45, 0.0, 0.0)];
+        assert_eq!(time_of_impact(&x, &opening, 1, pp, 0.0, 0.1, 1.0, 1.0), None);
     }
 
     #[test]
     fn separating_parallel_and_common_motion_never_hit() {
         let x = [Pt3::new(0.0, 0.0, 0.0), Pt3::new(1.0, 0.0, 0.0)];
         let away = [Vec3::new(-1.0, 0.0, 0.0), Vec3::new(1.0, 0.0, 0.0)];
-        assert_eq!(time_of_impact(&x, &away, 1, pp, 0.0, 0.1, 1.0), None);
+        assert_eq!(time_of_impact(&x, &away, 1, pp, 0.0, 0.1, 0.0, 1.0), None);
         let common = [Vec3::new(5.0, 3.0, 0.0), Vec3::new(5.0, 3.0, 0.0)];
-        assert_eq!(time_of_impact(&x, &common, 1, pp, 0.0, 0.1, 1.0), None);
+        assert_eq!(time_of_impact(&x, &common, 1, pp, 0.0, 0.1, 0.0, 1.0), None);
         // Sliding past at constant distance 1: no hit, bounded work.
         let slide = [Vec3::new(0.0, 0.0, 10.0), Vec3::zeros()];
-        assert_eq!(time_of_impact(&x, &slide, 1, pp, 0.0, 0.1, 1.0), None);
+        assert_eq!(time_of_impact(&x, &slide, 1, pp, 0.0, 0.1, 0.0, 1.0), None);
     }
 
     #[test]
@@ -115,7 +139,7 @@ mod tests {
             let x = [rp(&mut r), rp(&mut r), rp(&mut r), rp(&mut r)];
             let p = [rv(&mut r), rv(&mut r), rv(&mut r), rv(&mut r)];
             let g0 = d2(&x).sqrt();
-            let t = time_of_impact(&x, &p, 1, d2, 0.0, 0.1, 1.0).unwrap_or(1.0);
+            let t = time_of_impact(&x, &p, 1, d2, 0.0, 0.1, 0.0, 1.0).unwrap_or(1.0);
             // Sample the motion up to t: the gap never falls below 0.1·g₀.
             for k in 0..=200 {
                 let tau = t * k as f64 / 200.0;

@@ -87,6 +87,11 @@ pub(crate) struct Ipc {
 /// Fraction of a pair's gap the CCD line search lets a step close at most.
 const CCD_KEEP: f64 = 0.1;
 
+/// The smallest gap any step may produce, as a fraction of d̂: the barrier's force there is
+/// ~10³ times its force at d̂/2, and a conflict that keeps pushing (a tracking constraint into
+/// an obstacle) stops at this gap instead of driving it to zero.
+const GAP_FLOOR: f64 = 1e-3;
+
 impl Ipc {
     pub(crate) fn new(mesh: &ShellMesh, effects: &Effects, cs: &CollisionSettings) -> Self {
         let mean_edge = mesh.mean_edge_length();
@@ -332,13 +337,14 @@ impl Ipc {
     pub(crate) fn max_step(&self, x: &[Pt3], dx: &[Vec3]) -> f64 {
         let Some(c) = self.cands.as_ref() else { return 1.0 };
         let (tris, edges) = (&self.tris, &self.edges);
+        let floor = GAP_FLOOR * self.dhat;
         let a_vt =
             c.vt.par_iter()
                 .with_min_len(512)
                 .map(|&(v, t)| {
                     let tri = tris[t as usize];
                     let ids = [v, tri[0], tri[1], tri[2]];
-                    toi4(&ids.map(|i| x[i as usize]), &ids.map(|i| dx[i as usize]), 1, pt_d2, 0.0)
+                    toi4(&ids.map(|i| x[i as usize]), &ids.map(|i| dx[i as usize]), 1, pt_d2, 0.0, floor)
                 })
                 .reduce(|| 1.0, f64::min);
         let a_ee =
@@ -347,12 +353,12 @@ impl Ipc {
                 .map(|&(e, f)| {
                     let (a, b) = (edges[e as usize], edges[f as usize]);
                     let ids = [a[0], a[1], b[0], b[1]];
-                    toi4(&ids.map(|i| x[i as usize]), &ids.map(|i| dx[i as usize]), 2, ee_d2, 0.0)
+                    toi4(&ids.map(|i| x[i as usize]), &ids.map(|i| dx[i as usize]), 2, ee_d2, 0.0, floor)
                 })
                 .reduce(|| 1.0, f64::min);
         let mut alpha = a_vt.min(a_ee);
         for (p, oc) in self.placed.iter().zip(&c.obs) {
-            alpha = alpha.min(obstacle_toi(p, oc, x, dx, tris, edges));
+            alpha = alpha.min(obstacle_toi(p, oc, x, dx, tris, edges, floor));
         }
         alpha
     }
@@ -378,13 +384,21 @@ fn ee_d2(y: &[Pt3; 4]) -> f64 {
     (a - b).norm_squared()
 }
 
-/// TOI of a 4-point pair as a step fraction (1 when no impact).
-fn toi4(x: &[Pt3; 4], dx: &[Vec3; 4], split: usize, d2: fn(&[Pt3; 4]) -> f64, xi: f64) -> f64 {
-    accd::time_of_impact(x, dx, split, d2, xi, CCD_KEEP, 1.0).unwrap_or(1.0)
+/// TOI of a 4-point pair as a step fraction (1 when no impact); `floor` the absolute gap floor.
+fn toi4(x: &[Pt3; 4], dx: &[Vec3; 4], split: usize, d2: fn(&[Pt3; 4]) -> f64, xi: f64, floor: f64) -> f64 {
+    accd::time_of_impact(x, dx, split, d2, xi, CCD_KEEP, floor, 1.0).unwrap_or(1.0)
 }
 
 /// Step bound from one placed obstacle (fixed during the step's Newton iterations).
-fn obstacle_toi(p: &Placed, c: &set::CoreCands, x: &[Pt3], dx: &[Vec3], tris: &[[u32; 3]], edges: &[[u32; 2]]) -> f64 {
+fn obstacle_toi(
+    p: &Placed,
+    c: &set::CoreCands,
+    x: &[Pt3],
+    dx: &[Vec3],
+    tris: &[[u32; 3]],
+    edges: &[[u32; 2]],
+    floor: f64,
+) -> f64 {
     match p {
         Placed::Half { normal, offset } => x
             .par_iter()
@@ -393,12 +407,13 @@ fn obstacle_toi(p: &Placed, c: &set::CoreCands, x: &[Pt3], dx: &[Vec3], tris: &[
             .map(|(q, d)| {
                 let g0 = normal.dot(&q.coords) - offset;
                 let rate = normal.dot(d);
-                if rate < 0.0 && g0 > 0.0 {
-                    ((1.0 - CCD_KEEP) * g0 / -rate).min(1.0)
-                } else if g0 <= 0.0 && rate < 0.0 {
-                    0.0
-                } else {
+                let target = (CCD_KEEP * g0).max(floor);
+                if rate >= 0.0 {
                     1.0
+                } else if g0 > target {
+                    ((g0 - target) / -rate).min(1.0)
+                } else {
+                    0.0
                 }
             })
             .reduce(|| 1.0, f64::min),
@@ -409,24 +424,24 @@ fn obstacle_toi(p: &Placed, c: &set::CoreCands, x: &[Pt3], dx: &[Vec3], tris: &[
             for &(v, t) in &c.v_ot {
                 let (v, ot) = (v as usize, core.tris[t as usize]);
                 let y = [x[v], pt(ot[0]), pt(ot[1]), pt(ot[2])];
-                alpha = alpha.min(toi4(&y, &[dx[v], z, z, z], 1, pt_d2, core.xi));
+                alpha = alpha.min(toi4(&y, &[dx[v], z, z, z], 1, pt_d2, core.xi, floor));
             }
             for &(e, f) in &c.e_oe {
                 let (a, ob) = (edges[e as usize], core.edges[f as usize]);
                 let y = [x[a[0] as usize], x[a[1] as usize], pt(ob[0]), pt(ob[1])];
-                alpha = alpha.min(toi4(&y, &[dx[a[0] as usize], dx[a[1] as usize], z, z], 2, ee_d2, core.xi));
+                alpha = alpha.min(toi4(&y, &[dx[a[0] as usize], dx[a[1] as usize], z, z], 2, ee_d2, core.xi, floor));
             }
             for &(v, q) in &c.v_op {
                 let v = v as usize;
                 let pp = |y: &[Pt3; 2]| (y[0] - y[1]).norm_squared();
-                let t = accd::time_of_impact(&[x[v], pt(q)], &[dx[v], z], 1, pp, core.xi, CCD_KEEP, 1.0);
+                let t = accd::time_of_impact(&[x[v], pt(q)], &[dx[v], z], 1, pp, core.xi, CCD_KEEP, floor, 1.0);
                 alpha = alpha.min(t.unwrap_or(1.0));
             }
             for &(t, q) in &c.t_op {
                 let tri = tris[t as usize];
                 let y = [pt(q), x[tri[0] as usize], x[tri[1] as usize], x[tri[2] as usize]];
                 let d = [z, dx[tri[0] as usize], dx[tri[1] as usize], dx[tri[2] as usize]];
-                alpha = alpha.min(toi4(&y, &d, 1, pt_d2, core.xi));
+                alpha = alpha.min(toi4(&y, &d, 1, pt_d2, core.xi, floor));
             }
             alpha
         }
