@@ -61,8 +61,7 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::geom_core::register(&mut v);
     crate::scenes::barnet::register(&mut v);
     crate::scenes::shells::register(&mut v);
-    crate::scenes::tracks::register(&mut v);
-    crate::scenes::tracks_variants::register(&mut v);
+    crate::crates::tracks::register(&mut v);
     crate::scenes::curve_skin::register(&mut v);
     crate::scenes::rigging::register(&mut v);
     crate::scenes::motion_graph::register(&mut v);

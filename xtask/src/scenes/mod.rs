@@ -12,6 +12,4 @@ pub mod motion_graph;
 pub mod perf_control;
 pub mod rigging;
 pub mod shells;
-pub mod tracks;
-pub mod tracks_variants;
 pub mod wrinkles;
