@@ -390,6 +390,42 @@ pub fn sampled_liquid_volume(scene: &crate::scene::Scene, n: usize) -> f64 {
     c as f64 * d.x * d.y * d.z
 }
 
+/// Top of the liquid body: the largest `y + r` over the non-ballistic particles (m; NaN without
+/// one).
+pub fn liquid_top(p: &Particles) -> f64 {
+    (0..p.len()).filter(|&i| !p.is_ballistic(i)).map(|i| p.x[i].y + p.r[i]).fold(f64::NAN, |a, b| {
+        if a.is_nan() {
+            b
+        } else {
+            stats::nan_max(a, b)
+        }
+    })
+}
+
+/// The rest state of the particles' liquid in the scene's box (spec §6 S10): the particle volume
+/// `V = Σ (2r)³` spread flat over the domain floor `A` (obstacles ignored) has the surface height
+/// `h = y_floor + V / A` and the potential energy `ρ g V (y_floor + (h − y_floor) / 2)` (J, the
+/// convention of `StepStats::potential_energy`). Returns `(energy J, h m)`.
+pub fn rest_potential_energy(scene: &crate::scene::Scene, p: &Particles) -> (f64, f64) {
+    let v = p.total_volume();
+    let area = (scene.domain.max[0] - scene.domain.min[0]) * (scene.domain.max[2] - scene.domain.min[2]);
+    let floor = scene.domain.min[1];
+    let depth = v / area;
+    let g = -scene.gravity[1];
+    (crate::sim::RHO * g * v * (floor + 0.5 * depth), floor + depth)
+}
+
+/// Splash height above the rest surface `h_rest` (m) from the liquid-top series `(t, top)`: the
+/// largest top after the time the top was lowest (the falling liquid has merged with the pool),
+/// minus `h_rest`. NaN for an empty series or NaN tops.
+pub fn splash_height(tops: &[(f64, f64)], h_rest: f64) -> f64 {
+    if tops.is_empty() || tops.iter().any(|x| x.1.is_nan()) {
+        return f64::NAN;
+    }
+    let k = (0..tops.len()).fold(0, |b, i| if tops[i].1 < tops[b].1 { i } else { b });
+    tops[k..].iter().map(|x| x.1).fold(f64::NEG_INFINITY, f64::max) - h_rest
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

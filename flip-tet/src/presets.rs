@@ -5,6 +5,7 @@
 use geom_core::experiment::BySize;
 
 use crate::error::{Result, SimError};
+use crate::experiments::probes::Probes;
 use crate::experiments::{
     adaptivity_payoff, dam_break, drop_pool, fvm_vs_nodal, holes_plate, open_splash, rest_pool, standing_wave,
     surface_mixed_radii,
@@ -87,6 +88,7 @@ pub fn rest_pool() -> rest_pool::Params {
             jitter_finest: None,
             finest: Some(sizes(16, 16, 32)),
         },
+        probes: Probes { heights: vec![(0.5, 0.125)], pressures: vec![[0.5, 0.1, 0.125], [0.25, 0.2, 0.0625]] },
     }
 }
 
@@ -107,6 +109,7 @@ pub fn dam_break() -> dam_break::Params {
         obj_every: 2,
         ply_every: 0,
         hires_every: 0,
+        resolution_study: Some(BySize::Modes(vec![], vec![], vec![16, 32, 64])),
     }
 }
 
@@ -180,7 +183,12 @@ pub fn holes_plate() -> holes_plate::Params {
     scene.fps = 30.0;
     scene.seed = 5;
     scene.obstacles = vec![plate];
-    scene.sizing = SizingParams { solid_curvature: Some(1.6), depth_floor: Some(0.25), ..Default::default() };
+    scene.sizing = SizingParams {
+        solid_curvature: Some(1.6),
+        solid_proximity: Some(2.0),
+        depth_floor: Some(0.25),
+        ..Default::default()
+    };
     holes_plate::Params {
         scene,
         finest: sizes(16, 32, 64),
@@ -265,7 +273,13 @@ pub fn corridor_camera() -> open_splash::Params {
     scene.fps = 20.0;
     scene.seed = 3;
     scene.obstacles = vec![bx([0.5, 0.0, 0.0], [1.5, 0.5, 1.5])];
-    let path = CameraPath::Orbit { center: (1.0, 0.0, 1.0), radius: 2.5, height: 1.0, period: 2.0, phase: 0.0 };
+    // Issue 26: a camera that first looks down the far leg of the U (the released liquid is out
+    // of view), then pulls back over 0.5–0.7 s to see the whole corridor.
+    let path = CameraPath::Keyframes(vec![
+        (0.0, (1.75, 1.5, 2.6), (1.75, 0.0, 0.6)),
+        (0.5, (1.75, 1.5, 2.6), (1.75, 0.0, 0.6)),
+        (0.7, (1.0, 2.5, 3.5), (1.0, 0.0, 1.0)),
+    ]);
     let vis = VisibilityParams { path, fov_y_deg: 50.0, aspect: 1.0, near: 0.05, far: 20.0, margin_r_max: 2.0 };
     scene.sizing = SizingParams { depth_floor: Some(0.25), visibility: Some(vis), ..Default::default() };
     open_splash::Params { scene, finest: sizes(32, 32, 64), duration: sizes(0.25, 1.0, 1.0), obj_every: 0 }

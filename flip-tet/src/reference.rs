@@ -44,6 +44,61 @@ pub const MARTIN_MOYCE_HEIGHT: [(f64, f64); 17] = [
     (7.40, 0.06),
 ];
 
+/// Martin & Moyce (1952), Fig. 3, surge front for `n² = 2`, `a = 2¼ in`: `(T = t √(2g/a), Z =
+/// x/a)`, as digitised in PySPH (`pysph/examples/db_exp_data.py`, `mm_data_2`, repository
+/// pypr/pysph, commit 483e444; J. C. Martin and W. J. Moyce, "An experimental study of the
+/// collapse of liquid columns on a rigid horizontal plane", Phil. Trans. R. Soc. Lond. A 244,
+/// 312–324). Covers a longer tank than [`MARTIN_MOYCE_FRONT`] (the spec's table, same figure).
+pub const MM_FRONT_A225: [(f64, f64); 15] = [
+    (0.832, 1.217),
+    (1.219, 1.474),
+    (1.997, 2.292),
+    (2.547, 2.995),
+    (3.345, 4.134),
+    (4.034, 4.944),
+    (4.418, 5.881),
+    (5.091, 6.980),
+    (5.685, 7.945),
+    (6.306, 8.966),
+    (6.822, 9.986),
+    (7.439, 10.963),
+    (8.031, 11.977),
+    (8.633, 13.005),
+    (9.237, 13.970),
+];
+
+/// Martin & Moyce (1952), Fig. 3, surge front for `n² = 2`, `a = 1⅛ in`: `(T, Z)` as in
+/// [`MM_FRONT_A225`] (PySPH `mm_data_1`, same provenance).
+pub const MM_FRONT_A1125: [(f64, f64); 10] = [
+    (0.849, 1.245),
+    (1.212, 1.443),
+    (1.602, 1.884),
+    (2.283, 2.689),
+    (2.950, 3.728),
+    (3.598, 4.528),
+    (3.905, 4.999),
+    (4.592, 5.841),
+    (4.961, 6.271),
+    (5.316, 6.717),
+];
+
+/// Koshizuka & Oka (1996), surge front of their dam-break experiment (column `L × 2L`,
+/// `L = 0.146` m): `(T = t √(2g/L), Z = x/L)`, as digitised in PySPH
+/// (`pysph/examples/db_exp_data.py`, `ko_data`, repository pypr/pysph, commit 483e444;
+/// S. Koshizuka and Y. Oka, "Moving-particle semi-implicit method for fragmentation of
+/// incompressible fluid", Nucl. Sci. Eng. 123, 421–434).
+pub const KO_FRONT: [(f64, f64); 9] = [
+    (0.0, 1.000),
+    (0.381, 1.111),
+    (0.769, 1.252),
+    (1.153, 1.505),
+    (1.537, 1.892),
+    (1.935, 2.241),
+    (2.323, 2.615),
+    (2.719, 3.003),
+    (3.096, 3.624),
+];
+
 /// Hydrostatic gauge pressure `ρ g d` (Pa) at depth `d` (m) below a free surface.
 pub fn hydrostatic_pressure(rho: f64, g: f64, depth: f64) -> f64 {
     rho * g * depth

@@ -1,11 +1,7 @@
-//! `cargo xtask bench flip-tet [--sweep <knob>]` (spec §9): accuracy against time, as loops over
-//! flip-tet's own experiment calls (`dam_break::dam_run`, `standing_wave::wave_run`,
-//! `experiments::simulate`) on the scene files' setups. Without `--sweep` the four sweeps the issue
-//! names run: `resolution` (dam break, RMS front error vs Martin & Moyce), `levels` (coarsest =
-//! finest … 8 at a fixed finest), `tol` (rest pool: direct vs MIC(0)-PCG tolerances), `bc`
-//! (first- vs second-order free surface). `--sweep` also selects `solver`, `remesh`, `cfl`, `pic`
-//! and `surface` (or `all`). Writes `accuracy_vs_time.csv`, `pareto.png` and one PNG per extra
-//! sweep; each run's `metrics.csv` and snapshots go to `runs/<name>/`.
+//! `cargo xtask bench flip-tet [--sweep <knob>]` (spec §9, flip-tet README "Benchmark sweeps"):
+//! accuracy against time as loops over flip-tet's experiment calls (`dam_break::dam_run`,
+//! `standing_wave::wave_run`, `experiments::simulate`) on the scene files' setups. Writes
+//! `accuracy_vs_time.csv`, `pareto.png`, one PNG per extra sweep and `runs/<name>/` per run.
 
 use flip_tet::error::SolverKind;
 use flip_tet::experiments::{dam_break, rest_pool, simulate, standing_wave, FrameOutput, RunOut, SimRun};
@@ -38,13 +34,11 @@ struct Bench {
 }
 
 impl Bench {
-    /// Runs `scene` writing `runs/<name>/metrics.csv` and its snapshots.
     fn sim(&self, scene: &Scene, name: &str) -> Result<SimRun> {
         let mut rec = FileRecorder::new(&self.runs.join(name))?;
         Ok(simulate(scene, &mut rec, RunOut::full("", FrameOutput::NONE), &mut |_, _| Ok(()))?)
     }
-
-    /// Dam break: (RMS front error vs Martin & Moyce, wall s, steps, mean particles, level-set drift).
+    /// Dam break: (RMS front error vs Martin & Moyce, wall s, steps, particles, level-set drift).
     fn dam(&self, scene: &Scene, name: &str) -> Result<(f64, f64, usize, f64, f64)> {
         let mut rec = FileRecorder::new(&self.runs.join(name))?;
         let d = dam_break::dam_run(scene, &mut rec, RunOut::full("", FrameOutput::NONE))?;
@@ -52,7 +46,6 @@ impl Bench {
         let drift = rel_drift(&d.run.stats, |x| x.vol_levelset);
         Ok((rms, d.run.wall, d.run.stats.len(), d.run.particles_avg(), drift))
     }
-
     /// Standing wave: (period error, damping ratio after half a period, wall s, steps).
     fn wave(&self, scene: &Scene, name: &str) -> Result<(f64, f64, f64, usize)> {
         let mut rec = FileRecorder::new(&self.runs.join(name))?;
@@ -60,7 +53,6 @@ impl Bench {
         let zeta = damping_ratio(&r.eta, 0.5 * r.th.period).unwrap_or(f64::NAN);
         Ok((r.period_rel_err(), zeta, r.wall, r.stats.len()))
     }
-
     fn row(&mut self, knob: &'static str, value: &str, run: (f64, usize, f64), metric: &'static str, err: f64) {
         self.rows.push((knob, value.to_string(), run.0, run.1, run.2, metric, err));
     }
@@ -184,11 +176,8 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
 /// on the rest pool at finest 16, 32 (64), 40 steps each; the error column is the max speed.
 fn sweep_solver(b: &mut Bench, out_dir: &std::path::Path) -> Result<()> {
     let res: Vec<u32> = if b.quick { vec![16, 32] } else { vec![16, 32, 64] };
-    let kinds = [
-        ("direct", SolverKind::DirectCholesky),
-        ("mic_pcg", SolverKind::PcgIc0),
-        ("jacobi_pcg", SolverKind::PcgJacobi),
-    ];
+    use SolverKind::{DirectCholesky, PcgIc0, PcgJacobi};
+    let kinds = [("direct", DirectCholesky), ("mic_pcg", PcgIc0), ("jacobi_pcg", PcgJacobi)];
     let mut plot = LinePlot::new("flip-tet: pressure solve time vs DOFs (rest pool)", "DOFs (mean)", "ms per solve")
         .log(true, true);
     for (name, kind) in kinds {
@@ -201,13 +190,8 @@ fn sweep_solver(b: &mut Bench, out_dir: &std::path::Path) -> Result<()> {
             let k = r.stats.len().max(1) as f64;
             let dofs = r.stats.iter().map(|x| x.n_dofs as f64).sum::<f64>() / k;
             let ms = 1e3 * r.stats.iter().map(|x| x.timings.solve).sum::<f64>() / k;
-            b.row(
-                "solver",
-                &format!("{name}_{n}"),
-                (r.wall, r.stats.len(), dofs),
-                "rest_max_speed",
-                max_speed(&r.stats),
-            );
+            let (v, speed) = (format!("{name}_{n}"), max_speed(&r.stats));
+            b.row("solver", &v, (r.wall, r.stats.len(), dofs), "rest_max_speed", speed);
             b.s.set(&format!("solve_ms_{name}_finest_{n}"), ms);
             b.s.set(&format!("solve_dofs_finest_{n}"), dofs);
             pts.push((dofs, ms.max(1e-6)));
@@ -250,15 +234,12 @@ fn sweep_pic(b: &mut Bench, out_dir: &std::path::Path) -> Result<()> {
 /// `surface`: Hulls, ZhuBridson, SphereUnion as the simulation surface on a rest pool jittered
 /// by 0.1, 200 steps: final kinetic energy (J) against wall time.
 fn sweep_surface(b: &mut Bench, out_dir: &std::path::Path) -> Result<()> {
-    use flip_tet::surface::SurfaceMethod;
+    use flip_tet::surface::SurfaceMethod::{Hulls, SphereUnion, ZhuBridson};
     let mut plot =
         LinePlot::new("flip-tet: jittered rest pool, final KE vs wall time", "wall time (s)", "kinetic energy (J)")
             .log(false, true);
-    for (name, label, m) in [
-        ("hulls", "Hulls", SurfaceMethod::Hulls),
-        ("zhu_bridson", "ZhuBridson", SurfaceMethod::ZhuBridson),
-        ("sphere_union", "SphereUnion", SurfaceMethod::SphereUnion),
-    ] {
+    let methods = [("hulls", "Hulls", Hulls), ("zhu_bridson", "ZhuBridson", ZhuBridson)];
+    for (name, label, m) in methods.into_iter().chain([("sphere_union", "SphereUnion", SphereUnion)]) {
         let mut s = b.pool.clone();
         (s.surface.method, s.particles.sampling_jitter, s.duration) = (m, 0.1, 200.0 * s.flip.dt_max);
         let r = b.sim(&s, &format!("surface_{name}"))?;

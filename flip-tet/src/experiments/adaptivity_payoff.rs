@@ -1,6 +1,8 @@
 //! S10 (spec §6): the drop-pool geometry run adaptive (coarsest 8) and uniform (coarsest =
 //! finest) at the same finest resolutions; particle and wall-time ratios at the largest one, and
-//! the cost and particle exponents over the compared resolutions.
+//! the cost and particle exponents over the compared resolutions; and the spec's equal-result
+//! checks that make the ratios meaningful (issue 26): the potential energy above the rest state's
+//! over time and the splash height above the rest surface, adaptive against uniform.
 //!
 //! ```no_run
 //! use flip_tet::experiments::adaptivity_payoff;
@@ -16,7 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{one, plot, simulate, sized_scene, FrameOutput, RunOut};
 use crate::error::Result;
-use crate::metrics::profile;
+use crate::metrics::{interp, profile, rest_potential_energy, splash_height};
 use crate::scene::Scene;
 
 /// Parameters (the scene file's `params`).
@@ -45,6 +47,10 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let mut cost = (Vec::new(), Vec::new());
     let mut parts = (Vec::new(), Vec::new());
     let mut last = (0.0, 0.0, 0.0, 0.0);
+    // Per variant of the last compared size: potential energy above the rest state's over time
+    // (J) and the splash height above the rest surface (m).
+    let mut pe: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+    let mut splash = [f64::NAN; 2];
     for &n in &list {
         for adaptive in [true, false] {
             let mut sc = base.clone();
@@ -54,7 +60,11 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
             }
             let name = if adaptive { "adaptive" } else { "uniform" };
             let dir = format!("{name}_{n}/");
-            let run = simulate(&sc, rec, RunOut::full(&dir, FrameOutput::NONE), &mut |_, _| Ok(()))?;
+            let mut tops = Vec::new();
+            let run = simulate(&sc, rec, RunOut::full(&dir, FrameOutput::NONE), &mut |sim, st| {
+                tops.push((st.t, crate::metrics::liquid_top(sim.particles())));
+                Ok(())
+            })?;
             let stats = &run.stats;
             let ps: f64 = stats.iter().map(|x| x.n_particles as f64).sum();
             let avg = ps / stats.len().max(1) as f64;
@@ -70,6 +80,10 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
                 ],
             )?;
             let sim_t = stats.last().map_or(1.0, |x| x.t).max(1e-9);
+            let (pe_rest, h_rest) = rest_potential_energy(&sc, run.sim.particles());
+            let k = usize::from(!adaptive);
+            pe[k] = stats.iter().map(|x| (x.t, x.potential_energy - pe_rest)).collect();
+            splash[k] = splash_height(&tops, h_rest);
             if adaptive {
                 cost.0.push((f64::from(n), run.wall / sim_t));
                 parts.0.push((f64::from(n), avg));
@@ -94,6 +108,23 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
             f64::NAN
         }
     };
+    // Equal-result checks (spec §6 S10): relative L2 over time of the potential energy above the
+    // rest state's (adaptive read at the uniform run's step times), and the splash heights.
+    let num: f64 = pe[1].iter().map(|&(t, e)| (interp(&pe[0], t) - e).powi(2)).sum();
+    let den: f64 = pe[1].iter().map(|&(_, e)| e * e).sum();
+    s.num("potential_energy_rel_l2_diff", if den > 0.0 { (num / den).sqrt() } else { f64::NAN });
+    s.num("splash_height_adaptive_m", splash[0]);
+    s.num("splash_height_uniform_m", splash[1]);
+    s.num("splash_height_rel_diff", (splash[0] - splash[1]).abs() / splash[1].abs());
+    s.check(
+        "potential_energy_rel_l2_diff",
+        Target::AtMost(0.05),
+        "spec §6 S10 / issue 26: equal potential-energy curves",
+    );
+    s.check("splash_height_rel_diff", Target::AtMost(0.15), "spec §6 S10 / issue 26: equal splash height");
+    let ax = ("t (s)", "potential energy above rest (J)");
+    plot(rec, "potential_energy", "adaptive", ax, (false, false), pe[0].clone())?;
+    plot(rec, "potential_energy", "uniform", ax, (false, false), pe[1].clone())?;
     s.num("beta_particles_adaptive", beta(&parts.0));
     s.num("beta_particles_uniform", beta(&parts.1));
     s.timing("alpha_cost_adaptive", beta(&cost.0));

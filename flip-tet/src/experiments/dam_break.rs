@@ -18,9 +18,10 @@ use serde::{Deserialize, Serialize};
 use super::{one, plot, simulate, sized_scene, FrameOutput, RunOut, SimRun};
 use crate::error::{Result, SimError};
 use crate::metrics::{
-    best_time_shift, column_height, front_errors, front_position, height_max_abs_err, rel_drift, run_figures,
+    best_time_shift, column_height, fit_time_shift, front_errors, front_position, height_max_abs_err, interp,
+    rel_drift, run_figures,
 };
-use crate::reference::{MARTIN_MOYCE_FRONT, MARTIN_MOYCE_HEIGHT};
+use crate::reference::{KO_FRONT, MARTIN_MOYCE_FRONT, MARTIN_MOYCE_HEIGHT, MM_FRONT_A1125, MM_FRONT_A225};
 use crate::scene::{Scene, Shape};
 
 /// Parameters (the scene file's `params`).
@@ -42,6 +43,35 @@ pub struct Params {
     /// High-resolution surface every this many frames (0 = never).
     #[serde(default)]
     pub hires_every: u64,
+    /// Extra runs at these finest resolutions (besides the main one), per size: the resolution
+    /// study of issue 26 (keys `*_finest_<n>`).
+    #[serde(default)]
+    pub resolution_study: Option<BySize<Vec<u32>>>,
+}
+
+/// Range and step of the fitted time shift `ΔT` (dimensionless time).
+pub const SHIFT_SEARCH: (f64, f64, f64) = (-1.0, 1.0, 0.001);
+
+/// The literature's surge-front curves the front is compared with: `(key tag, label, data)`.
+pub const FRONT_DATA: [(&str, &str, &[(f64, f64)]); 3] = [
+    ("mm", "Martin & Moyce 1952, a = 2.25 in", &MM_FRONT_A225),
+    ("mm_a1125", "Martin & Moyce 1952, a = 1.125 in", &MM_FRONT_A1125),
+    ("ko", "Koshizuka & Oka 1996", &KO_FRONT),
+];
+
+/// The front against each curve of [`FRONT_DATA`]: raw RMS relative error (no shift) as
+/// `front_rms_rel_err_<tag>`, the RMS after one fitted time-origin shift as
+/// `front_rms_rel_err_<tag>_shifted` and that shift `front_shift_T_<tag>` (`ΔT = Δt √(2g/a)`,
+/// positive when the simulation leads), each key followed by `suffix`.
+pub fn literature_figures(r: &mut Report, front: &[(f64, f64)], suffix: &str) {
+    for (tag, _, data) in FRONT_DATA {
+        let (_, raw) = front_errors(front, data);
+        let (lo, hi, step) = SHIFT_SEARCH;
+        let (shift, rms) = fit_time_shift(front, data, lo, hi, step);
+        r.num(&format!("front_rms_rel_err_{tag}{suffix}"), raw);
+        r.num(&format!("front_rms_rel_err_{tag}_shifted{suffix}"), rms);
+        r.num(&format!("front_shift_T_{tag}{suffix}"), shift);
+    }
 }
 
 /// One dam-break run: the dimensionless front `(T, Z)` and column height `(τ, H)` after every
@@ -111,7 +141,71 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     s.num("column_width_a_m", d.a);
     s.text("time_scaling", "T = t*sqrt(2g/a) (front), tau = t*sqrt(g/a) (height), a = column width");
     run_figures(&mut s, stats, d.run.wall);
+    literature_figures(&mut s, front, "");
     s.check("height_max_abs_err_tau_le_2_5", Target::AtMost(0.08), "spec §6 S2: column height within 0.08");
+    s.check(
+        "front_rms_rel_err_mm_shifted",
+        Target::AtMost(0.05),
+        "issue 26: vs Martin & Moyce a = 2.25 in, one fitted time shift",
+    );
+    s.check("front_shift_T_mm", Target::Within(0.0, 0.4), "issue 26: the fitted shift is a late release, 0 ≤ ΔT ≤ 0.4");
+    s.check(
+        "front_rms_rel_err_ko_shifted",
+        Target::AtMost(0.07),
+        "issue 26: vs Koshizuka & Oka 1996, one fitted time shift",
+    );
+    s.check("front_shift_T_ko", Target::Within(0.0, 0.4), "issue 26: 0 ≤ ΔT ≤ 0.4");
+    rec.table("front_vs_literature", &["source", "T", "Z_exp", "Z_sim_raw", "Z_sim_shifted", "shift_T"])?;
+    for (tag, label, data) in FRONT_DATA {
+        let shift = s.get_f64(&format!("front_shift_T_{tag}"));
+        plot(rec, "front_vs_literature", label, fa_axes(), (false, false), data.to_vec())?;
+        let t_end = front.last().map_or(0.0, |x| x.0);
+        for &(t, z) in data.iter().filter(|x| x.0 <= t_end) {
+            let cells = [
+                Cell::Text(tag.into()),
+                Cell::Num(t),
+                Cell::Num(z),
+                Cell::Num(interp(front, t)),
+                Cell::Num(interp(front, t - shift)),
+                Cell::Num(shift),
+            ];
+            rec.row("front_vs_literature", &cells)?;
+        }
+    }
+    plot(rec, "front_vs_literature", "simulation", fa_axes(), (false, false), front.clone())?;
+    if let Some(list) = &p.resolution_study {
+        for n in list.get(size) {
+            let mut sc = scene.clone();
+            sc.resolution.finest = n;
+            let dir = format!("finest_{n}/");
+            let r = dam_run(
+                &sc,
+                rec,
+                RunOut { dir: &dir, frames: FrameOutput::NONE, snapshots: false, metrics: true, probes: None },
+            )?;
+            let (_, raw) = front_errors(&r.front, &MARTIN_MOYCE_FRONT);
+            s.num(&format!("front_rms_rel_err_finest_{n}"), raw);
+            literature_figures(&mut s, &r.front, &format!("_finest_{n}"));
+            s.timing(&format!("wall_s_finest_{n}"), r.run.wall);
+            plot(rec, "front_resolution", &format!("finest {n}"), fa_axes(), (false, false), r.front)?;
+        }
+        plot(
+            rec,
+            "front_resolution",
+            &format!("finest {}", scene.resolution.finest),
+            fa_axes(),
+            (false, false),
+            front.clone(),
+        )?;
+        plot(
+            rec,
+            "front_resolution",
+            "Martin & Moyce 1952, a = 2.25 in",
+            fa_axes(),
+            (false, false),
+            MM_FRONT_A225.to_vec(),
+        )?;
+    }
     let fa = fa_axes();
     plot(rec, "front_vs_mm", "simulation", fa, (false, false), front.clone())?;
     plot(rec, "front_vs_mm", "Martin & Moyce 1952", fa, (false, false), MARTIN_MOYCE_FRONT.to_vec())?;

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use geom_core::record::{Attribute, Cell, MeshFrame, PointFrame, Recorder};
 
+use super::probes::Probes;
 use super::snapshots::Snapshots;
 use crate::error::Result;
 use crate::metrics::{csv_row, CSV_HEADER};
@@ -49,17 +50,19 @@ pub struct RunOut<'a> {
     pub snapshots: bool,
     /// Write `metrics.csv`.
     pub metrics: bool,
+    /// Probes sampled at every frame into `probes.csv` (none when `None` or empty).
+    pub probes: Option<&'a Probes>,
 }
 
 impl<'a> RunOut<'a> {
     /// Everything of a scene run in `dir` (metrics, snapshots, the given frames).
     pub fn full(dir: &'a str, frames: FrameOutput) -> Self {
-        Self { dir, frames, snapshots: true, metrics: true }
+        Self { dir, frames, snapshots: true, metrics: true, probes: None }
     }
 
     /// Nothing at all (benchmarks).
     pub fn silent() -> Self {
-        Self { dir: "", frames: FrameOutput::NONE, snapshots: false, metrics: false }
+        Self { dir: "", frames: FrameOutput::NONE, snapshots: false, metrics: false, probes: None }
     }
 }
 
@@ -71,6 +74,8 @@ pub struct SimRun {
     pub wall: f64,
     /// The simulator at the end.
     pub sim: FlipTetSim,
+    /// Probe values per frame (frame 0 first): `(t, heights m, pressures Pa)`.
+    pub probes: Vec<(f64, Vec<f64>, Vec<f64>)>,
 }
 
 impl SimRun {
@@ -153,6 +158,14 @@ pub fn simulate(
         Ok(())
     };
     write_frame(&sim, 0, rec)?;
+    let probes = out.probes.filter(|p| !p.is_empty());
+    let probe_table = format!("{}probes", out.dir);
+    let mut probe_values = Vec::new();
+    if let Some(p) = probes {
+        p.declare(rec, &probe_table)?;
+        let (h, pr) = p.record(&sim, rec, &probe_table)?;
+        probe_values.push((sim.time(), h, pr));
+    }
     let mut all = Vec::new();
     let mut frame = 0u64;
     let total = (scene.duration * scene.fps).round().max(1.0) as u64;
@@ -165,6 +178,10 @@ pub fn simulate(
         if st.frame_end {
             frame += 1;
             write_frame(&sim, frame, rec)?;
+            if let Some(p) = probes {
+                let (h, pr) = p.record(&sim, rec, &probe_table)?;
+                probe_values.push((sim.time(), h, pr));
+            }
             rec.progress(frame, total);
         }
         all.push(st);
@@ -173,7 +190,7 @@ pub fn simulate(
     if let Some(s) = snaps {
         s.finish(rec)?;
     }
-    Ok(SimRun { stats: all, wall, sim })
+    Ok(SimRun { stats: all, wall, sim, probes: probe_values })
 }
 
 /// What a frame-by-frame run (S5, S6) records per frame: `(t, particles, ballistic, wall s of

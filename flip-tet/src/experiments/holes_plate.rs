@@ -131,7 +131,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     if p.uniform_comparison.as_ref().is_some_and(|u| u.get(size)) {
         let mut u = scene.clone();
         u.resolution.coarsest = u.resolution.finest;
-        let out = RunOut { dir: "uniform/", frames: FrameOutput::NONE, snapshots: true, metrics: true };
+        let out = RunOut { dir: "uniform/", frames: FrameOutput::NONE, snapshots: true, metrics: true, probes: None };
         let ur = simulate(&u, rec, out, &mut |_, _| Ok(()))?;
         let up = volume_below(ur.sim.particles(), plate_bottom);
         s.num("passed_volume_uniform_m3", up);

@@ -26,6 +26,7 @@ pub mod drop_pool;
 pub mod fvm_vs_nodal;
 pub mod holes_plate;
 pub mod open_splash;
+pub mod probes;
 pub mod rest_pool;
 mod snapshots;
 pub mod standing_wave;

@@ -15,6 +15,7 @@ use geom_core::experiment::{BySize, Report, Size, Target};
 use geom_core::record::Recorder;
 use serde::{Deserialize, Serialize};
 
+use super::probes::Probes;
 use super::{one, plot, simulate, sized_scene, FrameOutput, RunOut};
 use crate::error::{Result, SolverKind};
 use crate::metrics::{max_speed, rel_drift, run_figures, surface_height};
@@ -44,6 +45,10 @@ pub struct Params {
     /// The extra runs of spec §6 S1 (all off when absent).
     #[serde(default)]
     pub variants: Variants,
+    /// Probes of S1a sampled every frame into `probes.csv` (issue 26): the pressure probes are
+    /// checked against hydrostatics `ρ g (H − y)` below the pool's box top `H`.
+    #[serde(default)]
+    pub probes: Probes,
 }
 
 /// The `variants: (...)` block: which extra runs to make (all `false` by default) and at which
@@ -93,6 +98,8 @@ pub struct RestRun {
     /// Largest `|surface_height − target|` over all steps at the probe columns (m; NaN without a
     /// target or when a probe found no surface).
     pub height_err: f64,
+    /// Probe values per frame.
+    pub probes: Vec<(f64, Vec<f64>, Vec<f64>)>,
 }
 
 impl RestRun {
@@ -124,14 +131,14 @@ pub fn rest_run(scene: &Scene, rec: &mut dyn Recorder, out: RunOut, target: Opti
         }
         Ok(())
     })?;
-    Ok(RestRun { stats: run.stats, wall: run.wall, max_disp: disp, height_err: herr })
+    Ok(RestRun { stats: run.stats, wall: run.wall, max_disp: disp, height_err: herr, probes: run.probes })
 }
 
 /// Runs S1a and the variants the parameters switch on.
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let scene = sized_scene(&p.scene, &p.finest, None, &p.duration, size);
     let frames = FrameOutput { obj: p.obj_every, ply: p.ply_every, hires: p.hires_every };
-    let r = rest_run(&scene, rec, RunOut::full("", frames), None)?;
+    let r = rest_run(&scene, rec, RunOut { probes: Some(&p.probes), ..RunOut::full("", frames) }, None)?;
     let mut s = Report::default();
     s.num("max_speed", max_speed(&r.stats));
     s.num("volume_drift_rel", rel_drift(&r.stats, |x| x.vol_levelset));
@@ -141,6 +148,9 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     run_figures(&mut s, &r.stats, r.wall);
     s.check("max_speed", Target::AtMost(1e-7), "spec §6 S1a: at rest to 1e-7 m/s");
     s.check("volume_drift_rel", Target::AtMost(1e-6), "spec §6 S1a: level-set volume drift ≤ 1e-6");
+    if !p.probes.pressures.is_empty() {
+        hydrostatic_figures(&scene, &p.probes, &r.probes, &mut s)?;
+    }
     let axes = ("step", "max speed (m/s)");
     plot(rec, "speed_vs_step", "second order, direct", axes, (false, true), r.speed_series())?;
     variants(p, &scene, size, rec, &mut s)?;
@@ -211,7 +221,7 @@ fn jitter_run(p: &Params, size: Size, scene: &Scene, rec: &mut dyn Recorder, s: 
     sc.resolution.finest = finest;
     sc.particles.sampling_jitter = 0.1;
     sc.duration = f64::from(v.jitter_steps.get(size)) * sc.flip.dt_max;
-    let out = RunOut { dir: "jitter/", frames: FrameOutput::NONE, snapshots: true, metrics: true };
+    let out = RunOut { dir: "jitter/", frames: FrameOutput::NONE, snapshots: true, metrics: true, probes: None };
     let run = simulate(&sc, rec, out, &mut |_, _| Ok(()))?;
     let ke: Vec<(f64, f64)> = run.stats.iter().map(|x| (x.step as f64, x.kinetic_energy)).collect();
     s.num("jitter_ke_initial_J", ke.first().map_or(f64::NAN, |x| x.1));
@@ -222,5 +232,45 @@ fn jitter_run(p: &Params, size: Size, scene: &Scene, rec: &mut dyn Recorder, s: 
     s.timing("jitter_wall_s", run.wall);
     let floored = ke.iter().map(|&(k, e)| (k, e.max(1e-30))).collect();
     plot(rec, "jitter/ke_vs_step", "jitter 0.1", ("step", "kinetic energy (J)"), (false, true), floored)?;
+    Ok(())
+}
+
+/// `probe_hydrostatic_rel_err`: the largest `|p − ρ g (H − y)| / (ρ g (H − y))` over the pressure
+/// probes and the frames after the first step (`H` = the pool box's top), and
+/// `probe_height_max_abs_err_m` against `H` for the height probes (issue 26).
+fn hydrostatic_figures(
+    scene: &Scene,
+    probes: &Probes,
+    values: &[(f64, Vec<f64>, Vec<f64>)],
+    s: &mut Report,
+) -> Result<()> {
+    let top = match scene.liquid.first() {
+        Some(crate::scene::Shape::Box { max, .. }) => max[1],
+        _ => {
+            return Err(crate::error::SimError::InvalidScene(
+                "rest-pool: the first liquid shape must be the pool Box".into(),
+            ))
+        }
+    };
+    let (rho, g) = (crate::sim::RHO, -scene.gravity[1]);
+    let mut err = 0.0;
+    let mut herr = 0.0;
+    for (_, h, p) in values.iter().skip(1) {
+        for (q, &v) in probes.pressures.iter().zip(p) {
+            let want = crate::reference::hydrostatic_pressure(rho, g, top - q[1]);
+            err = geom_core::stats::nan_max(err, (v - want).abs() / want);
+        }
+        for &v in h {
+            herr = geom_core::stats::nan_max(herr, (v - top).abs());
+        }
+    }
+    if values.len() < 2 {
+        err = f64::NAN;
+    }
+    s.num("probe_hydrostatic_rel_err", err);
+    if !probes.heights.is_empty() {
+        s.num("probe_height_max_abs_err_m", herr);
+    }
+    s.check("probe_hydrostatic_rel_err", Target::AtMost(0.01), "issue 26: a pressure probe reads ρ g depth within 1 %");
     Ok(())
 }
