@@ -67,8 +67,7 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::rigging::register(&mut v);
     crate::scenes::motion_graph::register(&mut v);
     crate::scenes::perf_control::register(&mut v);
-    crate::scenes::flip_tet::register(&mut v);
-    crate::scenes::flip_tet_adaptive::register(&mut v);
+    crate::crates::flip_tet::register(&mut v);
     crate::scenes::wrinkles::register(&mut v);
     v
 }
