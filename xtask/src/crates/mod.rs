@@ -1,0 +1,5 @@
+//! Per-crate adapters (issue 21): each loads a scene's `params` block, calls the crate's
+//! experiment with a file recorder ([`crate::record::run_experiment`]) and returns the figures
+//! of `summary.json`. Each module's `register` adds its runners.
+
+pub mod motion_graph;
