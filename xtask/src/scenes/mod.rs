@@ -3,7 +3,6 @@
 pub mod barnet;
 pub mod curve_skin;
 pub mod geom_core;
-pub mod motion_graph;
 pub mod perf_control;
 pub mod rigging;
 pub mod shells;
