@@ -486,7 +486,10 @@ pub fn k_best_embeddings(pr: &Problem, k: usize) -> Result<Vec<DiscreteEmbedding
         }
     }
     if out.is_empty() {
-        return Err(RigError::NoEmbedding { best_partial: if deepest.is_empty() { None } else { Some(deepest) } });
+        return Err(RigError::NoEmbedding {
+            best_partial: if deepest.is_empty() { None } else { Some(deepest) },
+            expanded,
+        });
     }
     Ok(out)
 }

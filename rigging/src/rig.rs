@@ -183,7 +183,7 @@ pub fn autorig(
     let pr = Problem::new(&graph, sk, &rs, &cand, o);
     let discrete = match k_best_embeddings(&pr, 1) {
         Ok(mut v) => v.remove(0),
-        Err(RigError::NoEmbedding { best_partial }) if graph.components > 1 && best_partial.is_none() => {
+        Err(RigError::NoEmbedding { best_partial, .. }) if graph.components > 1 && best_partial.is_none() => {
             return Err(RigError::GraphDisconnected { components: graph.components })
         }
         Err(e) => return Err(e),

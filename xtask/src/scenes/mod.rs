@@ -10,7 +10,6 @@ pub mod flip_tet_variants;
 pub mod geom_core;
 pub mod motion_graph;
 pub mod perf_control;
-pub mod rigging;
 pub mod shells;
 pub mod tracks;
 pub mod tracks_variants;
