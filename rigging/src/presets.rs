@@ -119,3 +119,21 @@ pub fn bent_arm_joints() -> (Pt3, Pt3, Pt3) {
 pub fn straight_arm_joints() -> (Pt3, Pt3, Pt3) {
     (Pt3::new(0.1, 0.5, 0.5), Pt3::new(0.5, 0.5, 0.5), Pt3::new(0.9, 0.5, 0.5))
 }
+
+/// A long-necked quadruped (giraffe-like, the hard case of issue 23 where the unbounded search
+/// blew up): [`quadruped_character`]'s body with the neck raised to `neck` × the body length
+/// above the shoulders and reaching forward half as far, the head at its end.
+pub fn long_necked_quadruped(seed: u64, neck: f64, target_vertices: usize) -> Result<(TriMesh, JointSet)> {
+    let (mut sdf, mut truth) = quadruped(1.0, 1.0, 1.0, 0.2, seed)?;
+    let (shoulders, old_neck, old_head) = (truth.rest[0], truth.rest[3], truth.rest[4]);
+    let new_neck = shoulders + Vec3::new(0.0, neck, 0.5 * neck);
+    let new_head = new_neck + (old_head - old_neck);
+    // Cones 0 and 1 are shoulders → neck and neck → head; sphere 0 is the head.
+    sdf.cones[0].b = new_neck;
+    sdf.cones[1].a = new_neck;
+    sdf.cones[1].b = new_head;
+    sdf.spheres[0].0 = new_head;
+    truth.rest[3] = new_neck;
+    truth.rest[4] = new_head;
+    Ok((build_mesh(&sdf, target_vertices)?, truth))
+}

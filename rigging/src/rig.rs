@@ -246,9 +246,9 @@ impl Rig {
         Ok(SkinSkeleton::from_positions(names, parent, &pos)?)
     }
 
-    /// The rigged skeleton as an animation skeleton (`anim::Skeleton::from_joint_positions`).
+    /// The rigged skeleton as an animation skeleton (`anim::Skeleton::from_joint_positions`),
+    /// with the template's roles (where a joint has none, the role guessed from its name stays).
     pub fn anim_skeleton(&self) -> Result<geom_core::anim::Skeleton> {
-        let names: Vec<String> = self.template.joints.iter().map(|j| j.name.clone()).collect();
-        Ok(geom_core::anim::Skeleton::from_joint_positions(&names, &self.template.parents(), &self.joints)?)
+        self.template.anim_skeleton(&self.joints)
     }
 }

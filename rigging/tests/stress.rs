@@ -125,6 +125,7 @@ fn single_bone_skeleton_weights_are_one_and_queue_cap_uncertifies() {
                 symmetric_to: None,
                 foot: false,
                 fat: true,
+                role: None,
             },
             TemplateJoint {
                 name: "b".into(),
@@ -133,6 +134,7 @@ fn single_bone_skeleton_weights_are_one_and_queue_cap_uncertifies() {
                 symmetric_to: None,
                 foot: true,
                 fat: false,
+                role: None,
             },
         ],
     };

@@ -3,8 +3,10 @@
 //! enclosed volume per frame shows how much LBS loses.
 //!
 //! Outputs: table `frames` (frame, time s, volume ratio), mesh frames `frames/NNNN.obj` every
-//! `obj_every` frames, and the rig as `rig.ron` (joint names, joint positions, sparse weights).
-//! [`animate`] also returns the rig and the walk, for writers of animated files.
+//! `obj_every` frames, the rig as `rig.ron` (joint names, joint positions, sparse weights) and
+//! the walking character as binary glTF `walk.glb` (`geom_core::io::gltf`: the skinning skeleton's
+//! joints, the bone-heat weights, the walk as joint rotations and root translation).
+//! [`animate`] also returns the rig and the walk.
 //!
 //! ```no_run
 //! use geom_core::experiment::{BySize, Size};
@@ -18,6 +20,7 @@
 use geom_core::anim::skin::{forward_kinematics, lbs, skinning_transforms, SkinSkeleton};
 use geom_core::anim::Pose;
 use geom_core::experiment::{BySize, Report, Size};
+use geom_core::io::gltf::{skinned_glb, GltfAnimation, GltfJoint, SkinnedMesh};
 use geom_core::math::Pt3;
 use geom_core::record::{MeshFrame, Recorder};
 use geom_core::stats;
@@ -64,7 +67,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
 }
 
 /// Runs the experiment. Figures: `frames`, `vertices`, `volume_ratio_min`, `volume_ratio_max`
-/// (enclosed volume of the skinned mesh over the rest volume, over the frames). Errors:
+/// (enclosed volume of the skinned mesh over the rest volume, over the frames), `gltf_bytes`
+/// (size of `walk.glb`), `gltf_joints`. Errors:
 /// `InvalidParameter` for a non-positive frame rate.
 pub fn animate(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<(Report, WalkAnimation)> {
     if !(p.fps > 0.0 && p.fps.is_finite()) {
@@ -111,10 +115,23 @@ pub fn animate(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<(Report
     ))
     .map_err(|e| RigError::InvalidParameter(format!("rig.ron: {e}")))?;
     rec.file("rig.ron", ron_text.as_bytes())?;
+    let joints = GltfJoint::from_skin_skeleton(&ssk);
+    let anim = GltfAnimation::from_skin_poses(&ssk, &times, &poses, "walk")?;
+    let glb = skinned_glb(&SkinnedMesh {
+        name: "character",
+        positions: &rig.mesh.positions,
+        faces: &rig.mesh.faces,
+        joints: &joints,
+        weights: &rig.weights,
+        animation: Some(&anim),
+    })?;
+    rec.file("walk.glb", &glb)?;
     let mut r = Report::default();
     r.count("frames", poses.len() as u64)
         .count("vertices", rig.mesh.n_vertices() as u64)
         .num("volume_ratio_min", vmin)
-        .num("volume_ratio_max", vmax);
+        .num("volume_ratio_max", vmax)
+        .count("gltf_bytes", glb.len() as u64)
+        .count("gltf_joints", joints.len() as u64);
     Ok((r, WalkAnimation { rig, skeleton: ssk, times, poses }))
 }
