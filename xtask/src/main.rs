@@ -16,6 +16,8 @@ mod bench_shells;
 mod bench_tracks;
 mod bench_wrinkles;
 mod checks;
+mod cmd_retarget;
+mod cmd_rig;
 mod crates;
 mod error;
 mod html;
@@ -123,6 +125,47 @@ enum Cmd {
         /// A method (<crate>/<runner>) or a crate.
         method: Option<String>,
     },
+    /// Rigs a character mesh: rig.json (joints and weights in the mesh's own axes and units),
+    /// the rigged character as character.glb and preview.png, into out/rig/<mesh name>/.
+    Rig {
+        /// The mesh (OBJ, PLY, OFF or GLB).
+        mesh: PathBuf,
+        /// Skeleton template: human, quadruped or a template .ron file.
+        #[arg(long, default_value = "human")]
+        skeleton: String,
+        /// The mesh's up axis (x, -y, +z, …); detected when not given.
+        #[arg(long, value_name = "AXIS", allow_hyphen_values = true)]
+        up: Option<String>,
+        /// The axis the character faces; detected when not given.
+        #[arg(long, value_name = "AXIS", allow_hyphen_values = true)]
+        front: Option<String>,
+        /// Length unit of the mesh for the glTF file (m, cm, mm, in; auto: from the height).
+        #[arg(long, default_value = "auto")]
+        units: String,
+        /// Output directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
+    /// Plays a BVH clip on a rig of `rig`: retargeted.bvh, animated.glb, skinned OBJ frames.
+    Retarget {
+        /// The BVH clip.
+        clip: PathBuf,
+        /// rig.json written by `cargo xtask rig`.
+        #[arg(long)]
+        rig: PathBuf,
+        /// Length unit of the rig (m, cm, mm, in; auto: from its height).
+        #[arg(long, default_value = "auto")]
+        units: String,
+        /// Skinning of the OBJ frames (lbs or dqs).
+        #[arg(long, default_value = "dqs")]
+        skinning: String,
+        /// Write every n-th skinned frame as OBJ (0: none).
+        #[arg(long, default_value_t = 10)]
+        every: usize,
+        /// Output directory.
+        #[arg(long, value_name = "DIR")]
+        out: Option<PathBuf>,
+    },
     /// Every built-in scene and benchmark, then the report out/report/index.html (and index.md).
     Repro {
         /// Smoke run of a few minutes.
@@ -172,6 +215,14 @@ fn main() -> ExitCode {
         }
         Cmd::Inspect { file } => inspect::inspect(&file),
         Cmd::Params { method } => params::print(method.as_deref()),
+        Cmd::Rig { mesh, skeleton, up, front, units, out } => {
+            let out = out.unwrap_or_else(|| out::default_out_root().join("rig").join(stem(&mesh)));
+            cmd_rig::run(&cmd_rig::RigArgs { mesh, skeleton, up, front, units, out })
+        }
+        Cmd::Retarget { clip, rig, units, skinning, every, out } => {
+            let out = out.unwrap_or_else(|| out::default_out_root().join("retarget").join(stem(&clip)));
+            cmd_retarget::run(&cmd_retarget::RetargetArgs { clip, rig, units, skinning, every, out })
+        }
         Cmd::Repro { quick, full, out } => report::repro(mode(quick, full), out.unwrap_or_else(out::default_out_root)),
         Cmd::Report { out_dir } => report::rebuild(&out_dir.unwrap_or_else(out::default_out_root)),
     };
@@ -269,4 +320,9 @@ fn bench_one(
     let r = run::run_bench(krate, sweep.as_deref(), &opts)?;
     run::print_closing(&id, mode, &dir, &r, verbose);
     Ok(())
+}
+
+/// The file name without extension (for default output folders).
+fn stem(p: &std::path::Path) -> String {
+    p.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "input".into())
 }

@@ -83,7 +83,7 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::tracks::register(&mut v);
     crate::scenes::tracks_variants::register(&mut v);
     crate::scenes::curve_skin::register(&mut v);
-    crate::scenes::rigging::register(&mut v);
+    crate::crates::rigging::register(&mut v);
     crate::crates::motion_graph::register(&mut v);
     crate::scenes::perf_control::register(&mut v);
     crate::crates::flip_tet::register(&mut v);

@@ -448,3 +448,18 @@ mod tests {
         assert!(r.unwrap_err().to_string().contains("kaboom"));
     }
 }
+
+/// Runs a scene as the tests do: `mode` into `dir` (cleared first), no previews, no progress
+/// label; returns the figures of `summary.json`.
+#[cfg(test)]
+pub fn run_scene_for_test(scene_id: &str, file: &Path, mode: Mode, dir: &Path) -> Result<Summary> {
+    let o = RunOptions {
+        mode,
+        out_dir: dir.to_path_buf(),
+        policy: DirPolicy::Owned,
+        overrides: Vec::new(),
+        previews: false,
+        label: scene_id.to_string(),
+    };
+    run_scene(scene_id, file, &o).map(|r| r.summary)
+}

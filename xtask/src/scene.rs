@@ -461,6 +461,7 @@ mod tests {
         assert_eq!(s.params.frames, (10, 90, 240));
         assert_eq!(s.params.shell.material.friction, 0.3, "a defaulted field is added");
         assert_eq!(s.params.shell.material.name, "cotton");
+        assert_eq!(s.params.shell.substeps, 4, "untouched fields keep the file's value");
         let s = set(&["shell.material=(density: 1.0, name: \"silk\")"]).unwrap();
         assert_eq!(s.params.shell.material.name, "silk");
         // A value of the wrong type is refused the way the file's would be, naming the override.

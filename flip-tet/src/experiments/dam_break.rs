@@ -52,8 +52,11 @@ pub struct Params {
 /// Range and step of the fitted time shift `ΔT` (dimensionless time).
 pub const SHIFT_SEARCH: (f64, f64, f64) = (-1.0, 1.0, 0.001);
 
-/// The literature's surge-front curves the front is compared with: `(key tag, label, data)`.
-pub const FRONT_DATA: [(&str, &str, &[(f64, f64)]); 3] = [
+/// One literature curve: `(key tag, label, (T, Z) points)`.
+pub type FrontCurve = (&'static str, &'static str, &'static [(f64, f64)]);
+
+/// The literature's surge-front curves the front is compared with.
+pub const FRONT_DATA: [FrontCurve; 3] = [
     ("mm", "Martin & Moyce 1952, a = 2.25 in", &MM_FRONT_A225),
     ("mm_a1125", "Martin & Moyce 1952, a = 1.125 in", &MM_FRONT_A1125),
     ("ko", "Koshizuka & Oka 1996", &KO_FRONT),

@@ -29,6 +29,7 @@ mod sniff;
 mod text;
 mod tri;
 
+pub mod gltf;
 pub mod obj;
 pub mod off;
 pub mod ply;

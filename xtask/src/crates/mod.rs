@@ -4,3 +4,4 @@
 
 pub mod flip_tet;
 pub mod motion_graph;
+pub mod rigging;
