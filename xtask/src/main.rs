@@ -178,6 +178,13 @@ enum Cmd {
         #[arg(long, value_name = "DIR")]
         out: Option<PathBuf>,
     },
+    /// (Re)renders preview.png, preview.apng and the .usda files of existing run folders from the
+    /// frames and scene.json they hold; prints the time each took.
+    Preview {
+        /// Run folders.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+    },
     /// Builds OUT_DIR/report/index.html (and index.md) from the runs found in OUT_DIR at any
     /// depth (folders with summary.json or FAILED).
     Report {
@@ -224,6 +231,7 @@ fn main() -> ExitCode {
             cmd_retarget::run(&cmd_retarget::RetargetArgs { clip, rig, units, skinning, every, out })
         }
         Cmd::Repro { quick, full, out } => report::repro(mode(quick, full), out.unwrap_or_else(out::default_out_root)),
+        Cmd::Preview { dirs } => previews(&dirs),
         Cmd::Report { out_dir } => report::rebuild(&out_dir.unwrap_or_else(out::default_out_root)),
     };
     match result {
@@ -245,6 +253,15 @@ fn list() -> error::Result<()> {
     say!("benchmarks (cargo xtask bench <crate> [--quick | --full]):");
     for b in registry::benches() {
         say!("  {:width$}  {}", b.crate_name, b.description);
+    }
+    Ok(())
+}
+
+fn previews(dirs: &[PathBuf]) -> error::Result<()> {
+    for d in dirs {
+        let t = std::time::Instant::now();
+        let n = preview::render_run(d)?;
+        say!("preview {}: {n} sequences in {:.3} s", d.display(), t.elapsed().as_secs_f64());
     }
     Ok(())
 }
@@ -282,7 +299,7 @@ fn run_one(
         previews,
         label: id.clone(),
     };
-    match run::run_scene(&id, &file, &opts) {
+    match run::run_scene_with(&id, &file, &opts) {
         Ok(r) => {
             run::print_closing(&id, mode, &dir, &r, verbose);
             Ok(())

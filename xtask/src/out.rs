@@ -215,6 +215,30 @@ mod tests {
     }
 
     #[test]
+    fn atomic_writes_replace_whole_files_and_leave_no_temporary() {
+        let dir = std::env::temp_dir().join(format!("xtask-atomic-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        let mut s = Summary::new();
+        s.set("a", 1.0);
+        s.write(&dir).unwrap();
+        s.set("b", 2.0);
+        s.write(&dir).unwrap();
+        assert_eq!(Summary::read(&dir.join("summary.json")).unwrap().get("b"), Some(2.0));
+        let names: Vec<String> =
+            fs::read_dir(&dir).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, ["summary.json"], "no temporary file left");
+        // A failed write leaves neither the target nor a temporary file.
+        let e = write_atomic(&dir.join("missing/x.json"), b"{}").unwrap_err();
+        assert!(e.to_string().contains("missing"), "{e}");
+        assert!(write_atomic(&dir, b"{}").is_err(), "a folder cannot be replaced by a file");
+        let names: Vec<String> =
+            fs::read_dir(&dir).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, ["summary.json"]);
+        fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn csv_rejects_wrong_row_width() {
         let path = std::env::temp_dir().join(format!("xtask-csv-{}.csv", std::process::id()));
         let mut w = CsvWriter::create(&path, &["a", "b"]).unwrap();

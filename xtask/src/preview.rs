@@ -1,5 +1,6 @@
 //! Pictures and standard files of every animated result, made from the run folder alone: for
-//! every mesh sequence a run wrote (`<run>/<seq>/NNNN.obj`, at any depth up to three folders —
+//! every mesh sequence a run wrote (`<run>/<seq>/NNNN.obj`, numbered frames — gaps allowed, a
+//! sequence written every tenth frame keeps its timing — at any depth up to three folders,
 //! old-style runners included), a time-sampled USD file `<run>/<seq>.usda`, and for the run a
 //! strip of frames `preview.png` and an animation `preview.apng`, rendered with geom-core's
 //! rasteriser.
@@ -40,12 +41,14 @@ const BACKGROUND: [f32; 3] = [0.96, 0.97, 0.98];
 pub struct Sequence {
     /// Path of its folder relative to the run, with `/` (`frames`, `pcg/frames`).
     pub name: String,
-    /// Its frames `0000.obj, 0001.obj, …` in order.
+    /// Its frames `NNNN.obj` in order of their numbers.
     pub frames: Vec<PathBuf>,
+    /// The frame numbers (`0010.obj` is frame 10).
+    pub numbers: Vec<u64>,
 }
 
-/// The frame files of `dir` (`NNNN.obj`, numbered from 0 without gaps), or none.
-fn frame_files(dir: &Path) -> Vec<PathBuf> {
+/// The frame files of `dir` (`NNNN.obj`, at least four digits) by frame number, or none.
+fn frame_files(dir: &Path) -> Vec<(u64, PathBuf)> {
     let Ok(rd) = std::fs::read_dir(dir) else { return Vec::new() };
     let mut v: Vec<(u64, PathBuf)> = rd
         .flatten()
@@ -59,13 +62,12 @@ fn frame_files(dir: &Path) -> Vec<PathBuf> {
         })
         .collect();
     v.sort();
-    let n = v.iter().enumerate().take_while(|(k, (i, _))| *i == *k as u64).count();
-    v.truncate(n);
-    v.into_iter().map(|(_, p)| p).collect()
+    v.dedup_by_key(|(i, _)| *i);
+    v
 }
 
-/// Every mesh sequence under `run` (folders holding `0000.obj`, up to three levels deep), the
-/// ones called `frames` first, then by name.
+/// Every mesh sequence under `run` (folders holding numbered `NNNN.obj` frames, up to three
+/// levels deep), the ones called `frames` first, then by name.
 pub fn find_sequences(run: &Path) -> Vec<Sequence> {
     let mut out = Vec::new();
     let mut stack = vec![(run.to_path_buf(), 0usize)];
@@ -82,7 +84,8 @@ pub fn find_sequences(run: &Path) -> Vec<Sequence> {
                     .strip_prefix(run)
                     .map(|r| r.components().map(|c| c.as_os_str().to_string_lossy()).collect::<Vec<_>>().join("/"))
                     .unwrap_or_default();
-                out.push(Sequence { name, frames });
+                let (numbers, frames) = frames.into_iter().unzip();
+                out.push(Sequence { name, frames, numbers });
             }
             if depth < 2 {
                 stack.push((p, depth + 1));
@@ -103,8 +106,11 @@ struct Frame {
     faces: Vec<[u32; 3]>,
 }
 
+/// Reads one frame; a frame without faces (an empty liquid surface …) reads as an empty frame.
 fn read_frame(path: &Path) -> Result<Frame> {
-    let d = geom_core::io::obj::read_data(path)?;
+    let bytes = std::fs::read(path).map_err(io_err(path))?;
+    let d = geom_core::io::obj::parse(&bytes)
+        .map_err(|e| geom_core::Error::InFile { path: path.to_path_buf(), source: Box::new(e) })?;
     let mut faces = Vec::with_capacity(d.faces.len());
     for f in d.faces.rows() {
         for k in 1..f.len().saturating_sub(1) {
@@ -157,6 +163,8 @@ fn colormap(t: f64) -> [f32; 3] {
 struct Row {
     name: String,
     n_frames: usize,
+    /// Frame number of each frame of the sequence.
+    numbers: Vec<u64>,
     frames: Vec<(usize, Frame)>,
     /// Per shown frame, per vertex strain (empty when not coloured).
     strain: Vec<Vec<f64>>,
@@ -288,7 +296,9 @@ fn render_tile(st: &Stage, row: &Row, k: usize, ss: u32) -> ImageRgbF32 {
             if n.dot(&(eye - centroid)) < 0.0 {
                 n = -n;
             }
-            (0.35 + 0.65 * n.dot(&light).max(0.0)) as f32
+            // Key light from above plus a fill from the camera, so that undersides stay readable.
+            let to_eye = (eye - centroid).try_normalize(0.0).unwrap_or_else(Vec3::zeros);
+            (0.3 + 0.5 * n.dot(&light).max(0.0) + 0.25 * n.dot(&to_eye).max(0.0)) as f32
         })
         .collect();
     let strain = row.strain.get(k).filter(|s| !s.is_empty());
@@ -405,10 +415,11 @@ impl Canvas {
     }
 }
 
-fn time_label(i: usize, fps: Option<f64>) -> String {
+fn time_label(row: &Row, i: usize, fps: Option<f64>) -> String {
+    let n = row.numbers.get(i).copied().unwrap_or(i as u64);
     match fps {
-        Some(f) => format!("t = {:.2} s", i as f64 / f),
-        None => format!("frame {i}"),
+        Some(f) => format!("t = {:.2} s", n as f64 / f),
+        None => format!("frame {n}"),
     }
 }
 
@@ -439,7 +450,8 @@ fn load_row(
     if frames.iter().any(|f| f.faces.is_empty()) {
         return Ok(None);
     }
-    let usd_frames: Vec<UsdFrame> = frames.iter().map(|f| UsdFrame::new(&f.positions, &f.faces)).collect();
+    let usd_frames: Vec<UsdFrame> =
+        frames.iter().zip(&seq.numbers).map(|(f, &n)| UsdFrame::new(&f.positions, &f.faces).at(n as f64)).collect();
     let doc = format!("{} frames of {}/NNNN.obj written by cargo xtask", frames.len(), seq.name);
     let opts = UsdOptions { fps: fps.unwrap_or(24.0), doc, ..Default::default() };
     let usd_path = run.join(format!("{}.usda", seq.name));
@@ -470,7 +482,15 @@ fn load_row(
         })
         .flatten()
         .collect();
-    Ok(Some(Row { name: seq.name.clone(), n_frames: frames.len(), frames: shown, strain, strain_max, pinned }))
+    Ok(Some(Row {
+        name: seq.name.clone(),
+        n_frames: frames.len(),
+        numbers: seq.numbers.clone(),
+        frames: shown,
+        strain,
+        strain_max,
+        pinned,
+    }))
 }
 
 /// Writes `<seq>.usda` for every mesh sequence of the run folder `run`, and `preview.png` and
@@ -523,7 +543,8 @@ fn write_strip(run: &Path, rows: &[Row], items: &[SceneItem], fps: Option<f64>) 
         let y0 = ri as u32 * (th + label_h);
         for (ci, (tile, &i)) in tiles.iter().zip(&idx).enumerate() {
             c.blit(tile, ci as u32 * tw, y0 + label_h);
-            let label = if ci == 0 { format!("{}  {}", row.name, time_label(i, fps)) } else { time_label(i, fps) };
+            let label =
+                if ci == 0 { format!("{}  {}", row.name, time_label(row, i, fps)) } else { time_label(row, i, fps) };
             c.text(&label, ci as i32 * tw as i32 + 6, y0 as i32 + 3, 15.0);
         }
         if !row.strain.is_empty() {
@@ -553,7 +574,7 @@ fn write_animation(run: &Path, rows: &[Row], items: &[SceneItem], fps: Option<f6
                     let k = nearest(row, i);
                     c.blit(&render_tile(st, row, k, 2), ri as u32 * tw, label_h);
                     c.text(
-                        &format!("{}  {}", row.name, time_label(row.frames[k].0, fps)),
+                        &format!("{}  {}", row.name, time_label(row, row.frames[k].0, fps)),
                         (ri as u32 * tw) as i32 + 5,
                         2,
                         13.0,
@@ -563,7 +584,8 @@ fn write_animation(run: &Path, rows: &[Row], items: &[SceneItem], fps: Option<f6
             })
             .collect();
         // Real time when the frame rate is known (within 4–25 frames per second), else 10 fps.
-        let duration = fps.map(|f| (rows[0].n_frames.max(2) - 1) as f64 / f);
+        let span = rows[0].numbers.last().copied().unwrap_or(0).saturating_sub(rows[0].numbers[0]).max(1);
+        let duration = fps.map(|f| span as f64 / f);
         let play = duration.map(|d| (n.max(2) - 1) as f64 / d.max(1e-9)).unwrap_or(10.0).clamp(4.0, 25.0);
         let bytes = geom_core::image::encode_apng(&frames, play)?;
         if bytes.len() <= MAX_ANIMATION_BYTES || (scale < 0.4 && n <= 8) {
@@ -619,19 +641,25 @@ mod tests {
             }
         }
         std::fs::create_dir_all(run.join("notes")).unwrap();
-        std::fs::write(run.join("notes/0001.obj"), "v 0 0 0\n").unwrap(); // no frame 0: not a sequence
-        let names: Vec<String> = find_sequences(&run).into_iter().map(|s| s.name).collect();
-        assert_eq!(names, ["frames", "pcg/frames", "guide"]);
+        std::fs::write(run.join("notes/0001.obj"), "v 0 0 0\n").unwrap(); // points only: no USD, not drawn
+        let seqs = find_sequences(&run);
+        let names: Vec<&str> = seqs.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["frames", "pcg/frames", "guide", "notes"]);
+        // Sparse numbering keeps the frame numbers (time codes).
+        std::fs::rename(run.join("guide/0001.obj"), run.join("guide/0010.obj")).unwrap();
+        assert_eq!(find_sequences(&run)[2].numbers, [0, 10]);
         let items = vec![
             SceneItem::Ground { y: 0.0 },
             SceneItem::Pinned { sequence: "frames".into(), vertices: vec![0, 6] },
             SceneItem::FrameRate { fps: 24.0 },
         ];
         scene_items::write(&run, &items).unwrap();
-        assert_eq!(render_run(&run).unwrap(), 3);
+        assert_eq!(render_run(&run).unwrap(), 4);
         for f in ["preview.png", "preview.apng", "frames.usda", "pcg/frames.usda", "guide.usda"] {
             assert!(run.join(f).is_file(), "{f} missing");
         }
+        assert!(!run.join("notes.usda").exists());
+        assert!(std::fs::read_to_string(run.join("guide.usda")).unwrap().contains("endTimeCode = 10"));
         let apng = std::fs::metadata(run.join("preview.apng")).unwrap().len() as usize;
         assert!(apng <= MAX_ANIMATION_BYTES);
         let usda = std::fs::read_to_string(run.join("frames.usda")).unwrap();

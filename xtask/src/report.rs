@@ -17,7 +17,7 @@ use crate::checks::{self, CheckRow};
 use crate::error::{io_err, Error, Result};
 use crate::out::{ensure_dir, write_atomic, Summary};
 use crate::registry;
-use crate::run::{run_bench, run_scene, DirPolicy, Outcome, RunOptions, FAILED, RUN_JSON};
+use crate::run::{run_bench, run_scene_with, DirPolicy, Outcome, RunOptions, FAILED, RUN_JSON};
 use crate::scene::Mode;
 
 /// Runs everything and writes the report. A failing scene does not stop the others; the command
@@ -43,7 +43,7 @@ pub fn repro(mode: Mode, out_root: PathBuf) -> Result<()> {
         k += 1;
         let dir = out_root.join(&s.id);
         let t = Instant::now();
-        let r = run_scene(&s.id, &s.file, &opts(dir.clone(), mode, format!("[{k}/{total}] {}", s.id)));
+        let r = run_scene_with(&s.id, &s.file, &opts(dir.clone(), mode, format!("[{k}/{total}] {}", s.id)));
         let o = Outcome { id: s.id.clone(), wall_s: t.elapsed().as_secs_f64(), error: r.err().map(|e| e.to_string()) };
         say!("{}", status_line(&o, mode));
         outcomes.push(o);

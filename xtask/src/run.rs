@@ -223,9 +223,23 @@ fn generic_outputs(dir: &Path, summary: &mut Summary, enabled: bool) -> Result<f
     Ok(dt)
 }
 
+/// Runs a scene file with its runner into `out_dir` (the tool's own folder: cleared first, with
+/// previews) and returns the figures of its `summary.json`: [`run_scene_with`] with defaults.
+pub fn run_scene(scene_id: &str, file: &Path, mode: Mode, out_dir: &Path) -> Result<Summary> {
+    let o = RunOptions {
+        mode,
+        out_dir: out_dir.to_path_buf(),
+        policy: DirPolicy::Owned,
+        overrides: Vec::new(),
+        previews: true,
+        label: scene_id.to_string(),
+    };
+    run_scene_with(scene_id, file, &o).map(|r| r.summary)
+}
+
 /// Runs a scene file with its runner into `o.out_dir`; writes `summary.json` (with `wall_s` and
 /// `mode` added, last and atomically) and returns it. A failure leaves `FAILED` in the folder.
-pub fn run_scene(scene_id: &str, file: &Path, o: &RunOptions) -> Result<RunResult> {
+pub fn run_scene_with(scene_id: &str, file: &Path, o: &RunOptions) -> Result<RunResult> {
     prepare_dir(&o.out_dir, o.policy)?;
     scene::set_overrides(Some(file), o.overrides.clone());
     let progress = RunProgress::start(&o.label);
@@ -374,7 +388,12 @@ pub fn print_closing(id: &str, mode: Mode, dir: &Path, r: &RunResult, verbose: b
             );
         }
     } else {
-        let shown: Vec<_> = r.summary.iter().filter(|(k, _)| k.as_str() != "mode").take(8).collect();
+        // Without paper checks: the first figures that are not timings or run settings.
+        let timing = |k: &str| {
+            ["_s", "_ms", "_us", "_hz"].iter().any(|u| k.ends_with(u))
+                || ["_s_", "s_per_", "_per_s", "speedup", "threads", "profile", "mode"].iter().any(|t| k.contains(t))
+        };
+        let shown: Vec<_> = r.summary.iter().filter(|(k, _)| !timing(k)).take(8).collect();
         let w = shown.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
         for (k, v) in &shown {
             say!("  {k:w$} = {}", crate::checks::format_value(v));

@@ -7,7 +7,8 @@
 //! would smooth simulation meshes), two-sided. The stage metadata that USD's validators require is
 //! always set: `defaultPrim`, `upAxis` (Y, the toolkit's convention), `metersPerUnit` (1: the
 //! toolkit works in metres), `timeCodesPerSecond` and `framesPerSecond` (the frame rate), and the
-//! time range. Time code `k` is frame `k`.
+//! time range. Frame `k` is at time code `k` unless given its own ([`UsdFrame::at`]: a sequence
+//! written every tenth step keeps its timing).
 //!
 //! ```
 //! use geom_core::io::usd::{self, UsdFrame, UsdOptions};
@@ -35,13 +36,24 @@ pub struct UsdFrame<'a> {
     pub positions: &'a [Pt3],
     /// Triangles over `positions`.
     pub faces: &'a [[u32; 3]],
+    /// Its time code (frames at the frame rate); `None`: its index in the sequence.
+    pub time_code: Option<f64>,
 }
 
 impl<'a> UsdFrame<'a> {
-    /// A frame from positions and triangles.
+    /// A frame from positions and triangles, at the time code of its index.
     pub fn new(positions: &'a [Pt3], faces: &'a [[u32; 3]]) -> Self {
-        Self { positions, faces }
+        Self { positions, faces, time_code: None }
     }
+
+    /// The same frame at time code `t` (codes must increase along the sequence).
+    pub fn at(self, t: f64) -> Self {
+        Self { time_code: Some(t), ..self }
+    }
+}
+
+fn code(f: &UsdFrame, k: usize) -> f64 {
+    f.time_code.unwrap_or(k as f64)
 }
 
 /// Stage settings.
@@ -82,6 +94,12 @@ fn check(frames: &[UsdFrame], o: &UsdOptions) -> Result<()> {
         return Err(Error::InvalidParameter(format!("usd: meters_per_unit must be > 0, got {}", o.meters_per_unit)));
     }
     for (k, f) in frames.iter().enumerate() {
+        let t = code(f, k);
+        if !t.is_finite() || (k > 0 && t <= code(&frames[k - 1], k - 1)) {
+            return Err(Error::InvalidParameter(format!(
+                "usd: frame {k} has time code {t}, not after the previous one"
+            )));
+        }
         if f.faces.is_empty() || f.positions.is_empty() {
             return Err(Error::InvalidParameter(format!("usd: frame {k} has no faces or no vertices")));
         }
@@ -163,10 +181,10 @@ pub fn to_string(name: &str, frames: &[UsdFrame], o: &UsdOptions) -> Result<Stri
     if !o.doc.is_empty() {
         let _ = writeln!(s, "    doc = \"{}\"", o.doc.replace('\\', "\\\\").replace('"', "\\\""));
     }
-    let _ = writeln!(s, "    endTimeCode = {}", frames.len() - 1);
+    let _ = writeln!(s, "    endTimeCode = {}", code(&frames[frames.len() - 1], frames.len() - 1));
     let _ = writeln!(s, "    framesPerSecond = {}", o.fps);
     let _ = writeln!(s, "    metersPerUnit = {}", o.meters_per_unit);
-    let _ = writeln!(s, "    startTimeCode = 0");
+    let _ = writeln!(s, "    startTimeCode = {}", code(&frames[0], 0));
     let _ = writeln!(s, "    timeCodesPerSecond = {}", o.fps);
     s.push_str("    upAxis = \"Y\"\n)\n\n");
     let _ = writeln!(s, "def Xform \"{root}\" (\n    kind = \"component\"\n)\n{{");
@@ -175,7 +193,7 @@ pub fn to_string(name: &str, frames: &[UsdFrame], o: &UsdOptions) -> Result<Stri
     // extent: per frame.
     s.push_str("        float3[] extent.timeSamples = {\n");
     for (k, f) in frames.iter().enumerate() {
-        let _ = write!(s, "            {k}: ");
+        let _ = write!(s, "            {}: ", code(f, k));
         write_points(&mut s, &extent(f.positions));
         s.push_str(",\n");
     }
@@ -189,13 +207,13 @@ pub fn to_string(name: &str, frames: &[UsdFrame], o: &UsdOptions) -> Result<Stri
     } else {
         s.push_str("        int[] faceVertexCounts.timeSamples = {\n");
         for (k, f) in frames.iter().enumerate() {
-            let _ = write!(s, "            {k}: ");
+            let _ = write!(s, "            {}: ", code(f, k));
             write_counts(&mut s, f.faces.len());
             s.push_str(",\n");
         }
         s.push_str("        }\n        int[] faceVertexIndices.timeSamples = {\n");
         for (k, f) in frames.iter().enumerate() {
-            let _ = write!(s, "            {k}: ");
+            let _ = write!(s, "            {}: ", code(f, k));
             write_indices(&mut s, f.faces);
             s.push_str(",\n");
         }
@@ -203,7 +221,7 @@ pub fn to_string(name: &str, frames: &[UsdFrame], o: &UsdOptions) -> Result<Stri
     }
     s.push_str("        point3f[] points.timeSamples = {\n");
     for (k, f) in frames.iter().enumerate() {
-        let _ = write!(s, "            {k}: ");
+        let _ = write!(s, "            {}: ", code(f, k));
         write_points(&mut s, f.positions);
         s.push_str(",\n");
     }
@@ -247,6 +265,17 @@ mod tests {
             assert!(t.contains(needle), "missing {needle} in\n{t}");
         }
         assert_eq!(t.matches("faceVertexCounts").count(), 1);
+    }
+
+    #[test]
+    fn frames_keep_their_own_time_codes() {
+        let a = quad(0.0);
+        let f = [[0, 1, 2]];
+        let t =
+            to_string("s", &[UsdFrame::new(&a, &f), UsdFrame::new(&a, &f).at(10.0)], &UsdOptions::default()).unwrap();
+        assert!(t.contains("endTimeCode = 10") && t.contains("            10: ["), "{t}");
+        let back = [UsdFrame::new(&a, &f).at(5.0), UsdFrame::new(&a, &f).at(5.0)];
+        assert!(to_string("s", &back, &UsdOptions::default()).is_err(), "time codes must increase");
     }
 
     #[test]
