@@ -124,7 +124,7 @@ fn a_missing_motion_file_is_a_clear_error() {
     if let search::Source::Bvh { path, .. } = &mut p.database.sources[0] {
         *path = "/nonexistent/clip.bvh".into();
     }
-    let e = search::run(&p, Size::Tiny, &mut NullRecorder::default()).err().expect("must fail");
+    let Err(e) = search::run(&p, Size::Tiny, &mut NullRecorder::default()) else { panic!("must fail") };
     assert!(e.to_string().contains("/nonexistent/clip.bvh"), "{e}");
 }
 

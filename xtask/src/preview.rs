@@ -384,8 +384,8 @@ impl Canvas {
     fn put(&mut self, x: u32, y: u32, c: [f32; 3]) {
         if x < self.w && y < self.h {
             let i = 3 * (y * self.w + x) as usize;
-            for k in 0..3 {
-                self.data[i + k] = (c[k].clamp(0.0, 1.0) * 255.0).round() as u8;
+            for (d, v) in self.data[i..i + 3].iter_mut().zip(c) {
+                *d = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
             }
         }
     }

@@ -223,15 +223,16 @@ fn generic_outputs(dir: &Path, summary: &mut Summary, enabled: bool) -> Result<f
     Ok(dt)
 }
 
-/// Runs a scene file with its runner into `out_dir` (the tool's own folder: cleared first, with
-/// previews) and returns the figures of its `summary.json`: [`run_scene_with`] with defaults.
+/// Runs a scene file with its runner into `out_dir` as the tests do (the tool's own folder,
+/// cleared first; no previews) and returns the figures of its `summary.json`.
+#[cfg(test)]
 pub fn run_scene(scene_id: &str, file: &Path, mode: Mode, out_dir: &Path) -> Result<Summary> {
     let o = RunOptions {
         mode,
         out_dir: out_dir.to_path_buf(),
         policy: DirPolicy::Owned,
         overrides: Vec::new(),
-        previews: true,
+        previews: false,
         label: scene_id.to_string(),
     };
     run_scene_with(scene_id, file, &o).map(|r| r.summary)
@@ -466,19 +467,4 @@ mod tests {
         std::panic::set_hook(prev);
         assert!(r.unwrap_err().to_string().contains("kaboom"));
     }
-}
-
-/// Runs a scene as the tests do: `mode` into `dir` (cleared first), no previews, no progress
-/// label; returns the figures of `summary.json`.
-#[cfg(test)]
-pub fn run_scene_for_test(scene_id: &str, file: &Path, mode: Mode, dir: &Path) -> Result<Summary> {
-    let o = RunOptions {
-        mode,
-        out_dir: dir.to_path_buf(),
-        policy: DirPolicy::Owned,
-        overrides: Vec::new(),
-        previews: false,
-        label: scene_id.to_string(),
-    };
-    run_scene(scene_id, file, &o).map(|r| r.summary)
 }

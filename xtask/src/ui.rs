@@ -159,8 +159,7 @@ impl RunProgress {
                 bar.set_position(done.min(total));
             }
             Display::Plain { last_tenth } => {
-                if total > 0 {
-                    let tenth = (10 * done.min(total)) / total;
+                if let Some(tenth) = (10 * done.min(total)).checked_div(total) {
                     if tenth > *last_tenth {
                         *last_tenth = tenth;
                         tell!("  {label} {done}/{total} ({} %) {elapsed:.1} s", 10 * tenth);

@@ -341,7 +341,7 @@ fn run_mocap(ctx: &RunCtx) -> Result<Summary> {
 #[cfg(test)]
 mod tests {
     use crate::registry::builtin_scenes;
-    use crate::run::run_scene_for_test as run_scene;
+    use crate::run::run_scene;
     use crate::scene::Mode;
 
     /// Every built-in geom-core scene parses and runs end to end in quick mode, and its

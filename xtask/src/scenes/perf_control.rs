@@ -629,7 +629,7 @@ pub fn run_real(ctx: &RunCtx) -> Result<Summary> {
 #[cfg(test)]
 mod tests {
     use crate::registry::builtin_scenes;
-    use crate::run::run_scene_for_test as run_scene;
+    use crate::run::run_scene;
     use crate::scene::Mode;
 
     /// Every built-in perf-control scene parses and runs end to end in quick mode (each well under

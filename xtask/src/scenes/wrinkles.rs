@@ -847,7 +847,7 @@ pub fn run_precompute_cost(ctx: &RunCtx) -> Result<Summary> {
 #[cfg(test)]
 mod tests {
     use crate::registry::builtin_scenes;
-    use crate::run::run_scene_for_test as run_scene;
+    use crate::run::run_scene;
     use crate::scene::Mode;
 
     /// The cheap built-in wrinkles scenes run end to end in quick mode and W2 meets its pass
