@@ -1,5 +1,8 @@
-//! Per-crate adapters (issue 21): each module registers its crate's scene methods, each a call
-//! of the crate's experiment through [`crate::record::run_experiment`], and converts the
-//! crate's error type into [`crate::error::Error`].
+//! Per-crate adapters (issue 21): each loads a scene's `params` block, calls the crate's
+//! experiment with a file recorder ([`crate::record::run_experiment`]) and returns the figures
+//! of `summary.json`. Each module's `register` adds its runners.
 
+pub mod flip_tet;
+pub mod motion_graph;
+pub mod rigging;
 pub mod tracks;

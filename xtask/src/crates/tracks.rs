@@ -2,65 +2,38 @@
 //! `tracks::experiments`, run through [`run_experiment`] (parameters from the scene file,
 //! outputs through the file recorder, `summary.json` and `checks.json` from its report).
 
-use tracks::experiments as ex;
+use tracks::experiments::{
+    bag, bag_variants, box_twist, box_variants, fig3_band, fig4_sphere, fig6_partitions, fig7_clustering, flag,
+    table55, xavier,
+};
+use tracks::TrackError;
 
-use crate::error::{Error, Result};
+use crate::error::Error;
 use crate::record::run_experiment;
-use crate::registry::{RunCtx, Runner};
+use crate::registry::Runner;
 
-impl From<tracks::TrackError> for Error {
-    fn from(e: tracks::TrackError) -> Self {
-        Error::Run(format!("tracks: {e}"))
+impl From<TrackError> for Error {
+    fn from(e: TrackError) -> Self {
+        match e {
+            TrackError::Core(c) => Error::Core(c),
+            other => Error::Run(format!("tracks: {other}")),
+        }
     }
 }
 
 /// Adds tracks' scene methods.
 pub fn register(v: &mut Vec<Runner>) {
-    v.push(Runner { method: "tracks/flag", run: flag });
-    v.push(Runner { method: "tracks/box", run: box_twist });
-    v.push(Runner { method: "tracks/bag", run: bag });
-    v.push(Runner { method: "tracks/xavier", run: xavier });
-    v.push(Runner { method: "tracks/fig3-band", run: fig3 });
-    v.push(Runner { method: "tracks/fig4-sphere", run: fig4 });
-    v.push(Runner { method: "tracks/fig6-partitions", run: fig6 });
-    v.push(Runner { method: "tracks/fig7-clustering", run: fig7 });
-    v.push(Runner { method: "tracks/table55", run: table55 });
-    v.push(Runner { method: "tracks/box-variants", run: box_variants });
-    v.push(Runner { method: "tracks/bag-variants", run: bag_variants });
-}
-
-fn flag(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::flag::run)
-}
-fn box_twist(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::box_twist::run)
-}
-fn bag(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::bag::run)
-}
-fn xavier(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::xavier::run)
-}
-fn fig3(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::fig3_band::run)
-}
-fn fig4(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::fig4_sphere::run)
-}
-fn fig6(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::fig6_partitions::run)
-}
-fn fig7(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::fig7_clustering::run)
-}
-fn table55(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::table55::run)
-}
-fn box_variants(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::box_variants::run)
-}
-fn bag_variants(ctx: &RunCtx) -> Result<crate::out::Summary> {
-    run_experiment(ctx, ex::bag_variants::run)
+    v.push(Runner { method: "tracks/flag", run: |c| run_experiment(c, flag::run) });
+    v.push(Runner { method: "tracks/box", run: |c| run_experiment(c, box_twist::run) });
+    v.push(Runner { method: "tracks/bag", run: |c| run_experiment(c, bag::run) });
+    v.push(Runner { method: "tracks/xavier", run: |c| run_experiment(c, xavier::run) });
+    v.push(Runner { method: "tracks/fig3-band", run: |c| run_experiment(c, fig3_band::run) });
+    v.push(Runner { method: "tracks/fig4-sphere", run: |c| run_experiment(c, fig4_sphere::run) });
+    v.push(Runner { method: "tracks/fig6-partitions", run: |c| run_experiment(c, fig6_partitions::run) });
+    v.push(Runner { method: "tracks/fig7-clustering", run: |c| run_experiment(c, fig7_clustering::run) });
+    v.push(Runner { method: "tracks/table55", run: |c| run_experiment(c, table55::run) });
+    v.push(Runner { method: "tracks/box-variants", run: |c| run_experiment(c, box_variants::run) });
+    v.push(Runner { method: "tracks/bag-variants", run: |c| run_experiment(c, bag_variants::run) });
 }
 
 #[cfg(test)]
