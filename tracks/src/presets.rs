@@ -119,8 +119,18 @@ pub fn shell_desc(mesh: &TriMesh, material: Material, effects: Effects) -> Shell
 
 /// The ground plane y = 0 with Coulomb friction μ.
 pub fn ground(friction: f64) -> Obstacle {
-    Obstacle { shape: ObstacleShape::Plane { normal: Vec3::y(), offset: 0.0 }, friction, motion: None }
+    ground_at(friction, 0.0)
 }
+
+/// The ground plane y = `height` (m) with the given friction.
+pub fn ground_at(friction: f64, height: f64) -> Obstacle {
+    Obstacle { shape: ObstacleShape::Plane { normal: Vec3::y(), offset: height }, friction, motion: None }
+}
+
+/// Height of the bag's ground (m): 1 mm below the bag's base, which rests on y = 0. A barrier
+/// contact model (IPC, the shells default) needs a positive gap at the start; with the ground at
+/// y = 0 the first step fails ("contact pairs have no gap at the step's start").
+pub const BAG_GROUND_Y: f64 = -1e-3;
 
 // ---------------------------------------------------------------------------------------------
 // a setup
@@ -354,7 +364,7 @@ pub fn bag_setup(o: &ShellOptions) -> Result<Setup> {
         guide,
         prolongation: Some(p),
         tracked_rest: rest,
-        desc: Box::new(move || shell_desc(&r2, vinyl(), gravity_effects(sc, vec![ground(0.5)], contact))),
+        desc: Box::new(move || shell_desc(&r2, vinyl(), gravity_effects(sc, vec![ground_at(0.5, BAG_GROUND_Y)], contact))),
         tf,
         fps: 30.0,
         substeps: o.substeps,

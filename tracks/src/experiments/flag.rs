@@ -33,10 +33,21 @@ pub type Params = PairParams;
 /// Simulated time of each coarse preview (s): the whole guide clip.
 pub const PREVIEW_DURATION: f64 = 4.0;
 
+/// Simulated time of each coarse preview at a run size (s): [`PREVIEW_DURATION`], except 0.5 s
+/// at `Size::Tiny` (a smoke run of the pipeline: no preview reaches the branch by then, so the
+/// last design is kept and `stuck_preview` is 0).
+pub fn preview_duration(size: Size) -> f64 {
+    if size == Size::Tiny {
+        0.5
+    } else {
+        PREVIEW_DURATION
+    }
+}
+
 /// Runs the design loop and the tracked/untracked pair.
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     p.validate("tracks/flag")?;
-    let design = flag_design(PREVIEW_DURATION, p.contact)?;
+    let design = flag_design(preview_duration(size), p.contact)?;
     let setup = flag_setup(&design, &p.shell(size))?;
     let (out, mut r) = run_standard(p, size, &setup, false, rec)?;
     let last = |v: &[f64]| v.last().copied().unwrap_or(f64::NAN);

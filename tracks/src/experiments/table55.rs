@@ -28,7 +28,7 @@ use geom_core::record::{Cell, Recorder};
 use serde::Deserialize;
 use shells::ContactMethod;
 
-use super::flag::PREVIEW_DURATION;
+use super::flag::preview_duration;
 use super::protocol::{run_pair, track_opts, PairOpts, PairOut};
 use super::xavier::XAVIER_REGIONS;
 use crate::error::Result;
@@ -88,9 +88,9 @@ pub fn method_key(m: &KktMethod) -> &'static str {
 }
 
 /// The four scenes: 4 steps per frame, the bag 6 (its scene's setting).
-fn rows(self_collision: bool, contact: ContactMethod) -> Result<Vec<Row>> {
+fn rows(size: Size, self_collision: bool, contact: ContactMethod) -> Result<Vec<Row>> {
     let shell = &ShellOptions { substeps: 4, self_collision, contact };
-    let design = flag_design(PREVIEW_DURATION, contact)?;
+    let design = flag_design(preview_duration(size), contact)?;
     let x = xavier()?;
     let xg = xavier_guide(&x, XAVIER_DURATION)?;
     let (xtf, _) = xavier_tf(&x, &xg, XAVIER_REGIONS.0, XAVIER_REGIONS.1)?;
@@ -117,7 +117,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let dur = p.duration.get(size);
     let reps = p.repeats.get(size).max(1);
     let sc = p.self_collision.get(size);
-    let scenes = rows(sc, p.contact)?;
+    let scenes = rows(size, sc, p.contact)?;
     rec.table(
         "table55",
         &[
