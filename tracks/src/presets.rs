@@ -127,10 +127,11 @@ pub fn ground_at(friction: f64, height: f64) -> Obstacle {
     Obstacle { shape: ObstacleShape::Plane { normal: Vec3::y(), offset: height }, friction, motion: None }
 }
 
-/// Height of the bag's ground (m): 1 mm below the bag's base, which rests on y = 0. A barrier
-/// contact model (IPC, the shells default) needs a positive gap at the start; with the ground at
-/// y = 0 the first step fails ("contact pairs have no gap at the step's start").
-pub const BAG_GROUND_Y: f64 = -1e-3;
+/// Height of the bag's and Xavier's ground (m): 1 mm below their lowest vertices, which rest on
+/// y = 0. A barrier contact model (IPC, the shells default) needs a positive gap at the start;
+/// with the ground at y = 0 the first step fails ("contact pairs have no gap at the step's
+/// start").
+pub const GROUND_Y: f64 = -1e-3;
 
 // ---------------------------------------------------------------------------------------------
 // a setup
@@ -238,6 +239,9 @@ pub struct FlagDesign {
     pub preview_s: f64,
 }
 
+/// One coarse preview: its frames (positions per frame) and its throw velocity (v_x, v_y) (m/s).
+type PreviewRun = (Vec<Vec<Pt3>>, (f64, f64));
+
 /// The coarse preview design loop (§5.1): the 35-vertex flag thrown with each of 20 velocities
 /// (v_x ∈ {1.6 … 2.8}, v_y ∈ {0.5 … 2.0} m/s) for `duration` s; the first preview that ends
 /// stuck on the branch ([`stuck_on_branch`]) is the guide, else the last design (2.8, 2.0).
@@ -245,7 +249,8 @@ pub fn flag_design(duration: f64, contact: ContactMethod) -> Result<FlagDesign> 
     let coarse = flag_coarse()?;
     let t0 = Instant::now();
     let mut flags = Vec::new();
-    let mut chosen: Option<(Vec<Vec<Pt3>>, (f64, f64))> = None;
+    // The chosen preview's frames and its throw velocity (m/s).
+    let mut chosen: Option<PreviewRun> = None;
     let nf = frames_for(duration, FLAG_FPS);
     for &vx in &[1.6, 1.9, 2.2, 2.5, 2.8] {
         for &vy in &[0.5, 1.0, 1.5, 2.0] {
@@ -364,7 +369,7 @@ pub fn bag_setup(o: &ShellOptions) -> Result<Setup> {
         guide,
         prolongation: Some(p),
         tracked_rest: rest,
-        desc: Box::new(move || shell_desc(&r2, vinyl(), gravity_effects(sc, vec![ground_at(0.5, BAG_GROUND_Y)], contact))),
+        desc: Box::new(move || shell_desc(&r2, vinyl(), gravity_effects(sc, vec![ground_at(0.5, GROUND_Y)], contact))),
         tf,
         fps: 30.0,
         substeps: o.substeps,
@@ -394,7 +399,7 @@ pub fn xavier_effects(self_collision: bool, contact: ContactMethod) -> Effects {
     wind.turbulence = 0.5;
     wind.seed = 7;
     wind.schedule = vec![(3.99, 0.0), (4.0, 1.0), (7.0, 1.0), (7.01, 0.0)];
-    Effects { wind: Some(wind), ..gravity_effects(self_collision, vec![ground(0.5)], contact) }
+    Effects { wind: Some(wind), ..gravity_effects(self_collision, vec![ground_at(0.5, GROUND_Y)], contact) }
 }
 
 /// Xavier's cloth (the 3038-vertex mesh itself) tracking `guide` through `tf`, starting on the
