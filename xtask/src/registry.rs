@@ -32,7 +32,6 @@ impl RunCtx {
     /// stay as they are): `Obj(path: "mygrid.obj")` in `/home/u/shot.ron` is
     /// `/home/u/mygrid.obj`, wherever the command runs from. Built-in scenes reach the shipped
     /// assets as `../../assets/…`.
-    #[allow(dead_code)] // called by the crates' adapters as they move onto `run_experiment` (issue 21)
     pub fn resolve(&self, path: impl AsRef<Path>) -> PathBuf {
         crate::paths::resolve_in(&self.scene_file, path.as_ref())
     }

@@ -178,6 +178,7 @@ pub fn sanity_figures(r: &mut Report, suffix: &str, s: &Sanity, rs: &protocol::R
     r.num(&k("min_contact_gap_m"), if c.min_gap.is_finite() { c.min_gap } else { f64::NAN });
     r.count(&k("ccd_clamped_steps"), c.ccd_clamps as u64);
     r.count(&k("unconverged_steps"), c.unconverged as u64);
+    r.count(&k("contact_free_steps"), c.contact_free_steps as u64);
     r.count(&k("line_search_failures"), c.line_search_failures as u64);
 }
 

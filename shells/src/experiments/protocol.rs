@@ -80,6 +80,7 @@ impl RunStats {
         c.ccd_clamps += st.contact.ccd_clamps;
         c.line_search_failures += st.contact.line_search_failures;
         c.unconverged += st.contact.unconverged;
+        c.contact_free_steps += st.contact.contact_free_steps;
         c.friction = c.friction.max(st.contact.friction);
         c.active = c.active.max(st.contact.active);
         c.min_gap = if self.steps == 1 { st.contact.min_gap } else { c.min_gap.min(st.contact.min_gap) };
