@@ -12,7 +12,9 @@
 //! alignment), [`db`] (takes, instances, database), [`reduce`] (complete-linkage reduction),
 //! [`cell`] (one DP cell), [`dp`] (the DP, beam, forced segments), [`refine`] (upsampling
 //! refinement), [`output`] (target construction, post-processing, skeletal output), [`control`]
-//! (control builders), [`eval`] (metrics), [`data`] (procedural walks and mouse paths).
+//! (control builders), [`eval`] (metrics), [`data`] (procedural walks and mouse paths),
+//! [`pipeline`] (the end-to-end call [`drive`]), [`presets`] (the paper's databases) and
+//! [`experiments`] (the paper's experiments, callable without xtask).
 //!
 //! Conventions: metres, seconds, Y up, planar transforms = geom-core's [`geom_core::math::Planar`];
 //! frames at the working rate unless stated; shared boundary samples between consecutive
@@ -26,7 +28,10 @@ pub mod db;
 pub mod dp;
 pub mod error;
 pub mod eval;
+pub mod experiments;
 pub mod output;
+pub mod pipeline;
+pub mod presets;
 pub mod reduce;
 pub mod refine;
 pub mod track;
@@ -41,6 +46,8 @@ pub use output::{
     achieved_control, placed_motions, placed_segments, postprocess_segments, propagate, target_motion, target_points,
     Signal,
 };
+pub use pipeline::{drive, Driven};
+pub use presets::PreparedDb;
 pub use reduce::{ClusterBy, ClusterDistance, ClusterOptions, ClusterReport, Representative};
 pub use refine::refine;
 pub use track::PointTrack;

@@ -3,3 +3,4 @@
 //! of `summary.json`. Each module's `register` adds its runners.
 
 pub mod motion_graph;
+pub mod perf_control;

@@ -8,7 +8,6 @@ pub mod flip_tet_holes;
 pub mod flip_tet_snapshots;
 pub mod flip_tet_variants;
 pub mod geom_core;
-pub mod perf_control;
 pub mod rigging;
 pub mod shells;
 pub mod tracks;
