@@ -19,7 +19,7 @@ use geom_core::anim::Motion;
 use crate::db::MappingDb;
 use crate::dp::{interpret, DpParams, Interpretation};
 use crate::error::Result;
-use crate::output::target_motion;
+use crate::output::{propagate, target_motion, target_points};
 use crate::refine::refine;
 use crate::track::PointTrack;
 
@@ -55,4 +55,49 @@ pub fn drive(db: &MappingDb, db_fine: &MappingDb, x_fine: &PointTrack, factor: u
     let motion = target_motion(db_fine, &fine, true)?;
     let post_s = t2.elapsed().as_secs_f64();
     Ok(Driven { coarse, fine, motion, dp_s, refine_s, post_s })
+}
+
+/// What driving a point-cloud database (no source skeletons, e.g. the dance) produced.
+#[derive(Clone, Debug)]
+pub struct DrivenPoints {
+    /// The DP's chain at the working rate.
+    pub coarse: Interpretation,
+    /// The chain refined at the full rate.
+    pub fine: Interpretation,
+    /// Target points, raw concatenation of the placed segments (§3.9).
+    pub raw: PointTrack,
+    /// Target points post-processed (§3.10).
+    pub post: PointTrack,
+    /// The propagated per-frame annotations (§3.11), `None` when the instances carry none.
+    pub annotations: Option<Vec<u64>>,
+    /// DP wall time (s).
+    pub dp_s: f64,
+    /// Refinement wall time (s).
+    pub refine_s: f64,
+    /// Target points (raw and post-processed) and annotation propagation wall time (s).
+    pub post_s: f64,
+}
+
+/// [`drive`] for point output: the same DP and refinement, then the raw and post-processed target
+/// points and the propagated annotations (no skeleton needed).
+pub fn drive_points(
+    db: &MappingDb,
+    db_fine: &MappingDb,
+    x_fine: &PointTrack,
+    factor: usize,
+    dp: &DpParams,
+) -> Result<DrivenPoints> {
+    let x = x_fine.downsample(factor);
+    let t0 = Instant::now();
+    let coarse = interpret(db, &x, dp)?;
+    let dp_s = t0.elapsed().as_secs_f64();
+    let t1 = Instant::now();
+    let fine = refine(db_fine, x_fine, &coarse, factor, dp)?;
+    let refine_s = t1.elapsed().as_secs_f64();
+    let t2 = Instant::now();
+    let raw = target_points(db_fine, &fine, false)?;
+    let post = target_points(db_fine, &fine, true)?;
+    let annotations = propagate(db_fine, &fine)?;
+    let post_s = t2.elapsed().as_secs_f64();
+    Ok(DrivenPoints { coarse, fine, raw, post, annotations, dp_s, refine_s, post_s })
 }

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use geom_core::experiment::{Report, Size};
 use geom_core::record::NullRecorder;
-use perf_control::experiments::{load_params, mouse_paths, real_data, walk, walk_timing};
+use perf_control::experiments::{dance, dance_timing, load_params, mouse_paths, real_data, walk, walk_timing};
 
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ lives in the workspace").to_path_buf()
@@ -66,4 +66,33 @@ fn real_data_pc6() {
     });
     assert!(r.get_f64("segments_detected") > 10.0);
     assert!(r.get_f64("mid_rms_m").is_finite());
+}
+
+#[test]
+fn dance_pc4() {
+    let p: dance::Params = load_params(&scene("dance")).unwrap();
+    let r =
+        tests::assert_thread_independent("dance", || dance::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap());
+    // One test dance of 2 patterns: 8 two-beat segments, every figure defined.
+    assert_eq!(r.get_f64("two_beat_segments"), 8.0);
+    assert_eq!(r.get_f64("patterns"), 2.0);
+    for key in ["two_beat_error_rate", "closed_rms_m", "open_rms_m", "streaming_label_agreement", "held_gap_cm_ik"] {
+        assert!(r.get_f64(key).is_finite(), "{key} = {}", r.get_f64(key));
+    }
+    assert!(r.get_f64("held_gap_cm_ik") <= r.get_f64("held_gap_cm_post"), "the hand snap closes the gap");
+    assert!(check(&r, "streaming_latency_s"));
+    for cue in ["cue_30mm_", "cue_60mm_", "cue_120mm_"] {
+        assert!(r.get_f64(&format!("{cue}two_beat_error_rate")).is_finite());
+    }
+}
+
+#[test]
+fn dance_timing_pc5() {
+    let p: dance_timing::Params = load_params(&scene("dance-timing")).unwrap();
+    let r = tests::assert_thread_independent("dance-timing", || {
+        dance_timing::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap()
+    });
+    assert!(r.get_f64("beam_score_excess_rel") >= 0.0, "the beam cannot beat the exact optimum");
+    assert!(r.get_f64("exact_cells_expanded") >= r.get_f64("beam_cells_expanded"));
+    assert_eq!(r.get_f64("input_s"), 10.0);
 }

@@ -173,3 +173,56 @@ pub fn annotation_hits(propagated: &[u64], truth: &[u64]) -> (usize, usize) {
     let n = propagated.len().min(truth.len());
     (propagated.iter().zip(truth).take(n).filter(|(a, b)| a == b).count(), n)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dance::grammar::basic_patterns;
+
+    fn truth_of(patterns: &[Pattern]) -> DuetTruth {
+        let segments = patterns
+            .iter()
+            .flat_map(|p| p.labels().unwrap())
+            .enumerate()
+            .map(|(i, l)| (i as f64, i as f64 + 1.0, l))
+            .collect();
+        DuetTruth { patterns: patterns.to_vec(), bpm: 120.0, segments, annotations: vec![] }
+    }
+
+    /// A perfect output scores 0 errors; one misread toggle in a last segment keeps its pattern
+    /// valid; a misread stance makes it invalid; a missing label counts as an error.
+    #[test]
+    fn semantics_count_errors_and_validity() {
+        let pats: Vec<Pattern> = ["O:I1 U0", "OX:S1 S0"].iter().map(|s| Pattern::parse(s).unwrap()).collect();
+        // "O:I1 U0" ends in OX, then "OX:S1 S0" ends in O.
+        let t = truth_of(&pats);
+        let perfect: Vec<Option<DanceLabel>> = t.segments.iter().map(|s| Some(s.2)).collect();
+        let mut s = Semantics::default();
+        s.add(&t, &perfect);
+        assert_eq!((s.segments, s.segment_errors, s.pattern_matches), (8, 0, 2));
+        assert!(s.valid_share().is_nan(), "no mismatches: the share is undefined");
+        let mut out = perfect.clone();
+        let mut l = out[7].unwrap();
+        l.toggle = !l.toggle; // last segment of pattern 2: still grammatical
+        out[7] = Some(l);
+        let mut l = out[0].unwrap();
+        l.stance = crate::dance::grammar::Stance::C; // C with I is not grammatical
+        out[0] = Some(l);
+        let mut s = Semantics::default();
+        s.add(&t, &out);
+        assert_eq!((s.segment_errors, s.pattern_matches, s.mismatches_valid), (2, 0, 1));
+        assert_eq!(s.error_rate(), 0.25);
+        assert_eq!(s.valid_share(), 0.5);
+        assert_eq!(s.novel(&basic_patterns()), 0, "both patterns are basic");
+        assert_eq!(s.novel(&[]), 2);
+        let mut s = Semantics::default();
+        s.add(&t, &vec![None; 8]);
+        assert_eq!(s.segment_errors, 8);
+    }
+
+    /// Frames whose annotation matches.
+    #[test]
+    fn annotation_hits_count_equal_frames() {
+        assert_eq!(annotation_hits(&[1, 2, 4, 4], &[1, 2, 5]), (2, 3));
+    }
+}

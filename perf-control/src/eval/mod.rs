@@ -1,6 +1,7 @@
 //! Evaluation metrics (spec §3.14): control tracking, gait frequency and phase, seam jumps;
-//! [`path`] the path-following figures of PC-3.
+//! [`path`] the path-following figures of PC-3; [`dance`] the dance semantics of PC-4.
 
+pub mod dance;
 pub mod path;
 
 pub use path::{fastest_step_speed, intrinsic_speed, path_following, seam_frames, PathFollowing};

@@ -1,10 +1,12 @@
 //! The paper experiments of perf-control (spec §6), callable without xtask. Each module has a
 //! `Params` (the `params` block of its scene file `scenes/perf-control/<scene>.ron`) and
 //! `run(&Params, Size, &mut dyn Recorder) -> Result<Report>`:
-//! [`walk`] (PC-1), [`walk_timing`] (PC-2), [`mouse_paths`] (PC-3), [`real_data`] (PC-6);
+//! [`walk`] (PC-1), [`walk_timing`] (PC-2), [`mouse_paths`] (PC-3), [`real_data`] (PC-6), [`dance`] (PC-4), [`dance_timing`] (PC-5);
 //! [`sweeps`] holds the library calls of the accuracy-versus-time benchmark (spec §9).
 
 pub mod common;
+pub mod dance;
+pub mod dance_timing;
 pub mod mouse_paths;
 pub mod real_data;
 pub mod sweeps;
