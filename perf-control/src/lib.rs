@@ -24,6 +24,7 @@
 
 pub mod align;
 pub mod cell;
+pub mod clock;
 pub mod control;
 pub mod dance;
 pub mod data;

@@ -2,6 +2,10 @@
 //! eqs. 6–7 run online, one input frame at a time, committing the segment that covers frame
 //! `t − lag` as soon as frame `t` has arrived. The output therefore lags the control by exactly
 //! `lag` working frames — the path to live use — and the committed segments always form one chain.
+//! The last segment of the chain traced from frame `t` ends at `t` only because the input stops
+//! there, so it is never committed: when it covers `t − lag`, only the segments before it are
+//! committed and that frame waits (the measured latency, [`Streamed::latency_max_s`], can exceed
+//! the lag by up to one segment).
 //!
 //! Per new frame `t` the DP computes the row of cells ending at `t` in pull form (cell `(t, c)`
 //! takes the best live predecessor ending at `t − d_c`, ties to the lowest column as in
@@ -49,8 +53,15 @@ pub struct Streamed {
     pub it: Interpretation,
     /// The lag (working frames).
     pub lag_frames: usize,
-    /// The latency of the output behind the control (s) = `lag / rate`.
+    /// The nominal latency of the output behind the control (s) = `lag / rate`: no frame is
+    /// committed earlier.
     pub latency_s: f64,
+    /// The measured latency: the longest wait (s) between a frame's arrival and its commit, over
+    /// the frames committed before the end of the input (NaN when none was). Larger than
+    /// `latency_s` when the segment covering a frame was still the open last one.
+    pub latency_max_s: f64,
+    /// The median of the same waits (s).
+    pub latency_median_s: f64,
     /// Commit events before the end of the input.
     pub commits: usize,
     /// Rows recomputed after commits (the streaming overhead, in rows of `P` cells).
@@ -228,6 +239,8 @@ pub fn interpret_streaming(db: &MappingDb, x: &PointTrack, p: &DpParams, lag: us
     let mut committed: Vec<(usize, i64)> = Vec::new();
     let mut frontier: Option<(usize, usize)> = None;
     let mut committed_until: i64 = -1;
+    // Per input frame: the frame at which it was committed (the end of the input for the rest).
+    let mut commit_t = vec![t_len as usize - 1; t_len as usize];
     let (mut commits, mut recomputed) = (0usize, 0u64);
     for t in 1..t_len as usize {
         st.compute_row(t);
@@ -237,18 +250,23 @@ pub fn interpret_streaming(db: &MappingDb, x: &PointTrack, p: &DpParams, lag: us
         }
         let Some(c) = st.best_in_row(t) else { continue };
         let chain = st.trace(t, c, frontier);
-        // Commit up to and including the segment covering frame f.
-        let mut upto = None;
-        for (i, &(col, start)) in chain.iter().enumerate() {
-            if start + st.cols[col].d as i64 >= f {
-                upto = Some(i);
-                break;
-            }
+        // The last segment ends at t only because the chain was cut there: its end is no decision
+        // yet, so it is never committed. Commit up to and including the segment covering frame
+        // f, or, when that is the last one, every segment before it.
+        let body = chain.len().saturating_sub(1);
+        let upto = chain[..body]
+            .iter()
+            .position(|&(col, start)| start + st.cols[col].d as i64 >= f)
+            .unwrap_or(body.wrapping_sub(1));
+        if upto >= body {
+            continue;
         }
-        let Some(upto) = upto else { continue };
         committed.extend_from_slice(&chain[..=upto]);
         let (col, start) = chain[upto];
         let e = (start + st.cols[col].d as i64) as usize;
+        for g in (committed_until + 1).max(0) as usize..=e.min(t_len as usize - 1) {
+            commit_t[g] = t;
+        }
         frontier = Some((e, col));
         committed_until = e as i64;
         commits += 1;
@@ -289,7 +307,18 @@ pub fn interpret_streaming(db: &MappingDb, x: &PointTrack, p: &DpParams, lag: us
     }
     committed.extend(st.trace(best.1, best.2, frontier));
     let it = finish(db, x, &st.cols, &committed, p, best.0, clock, st.stats);
-    Ok(Streamed { it, lag_frames: lag, latency_s: lag as f64 / x.rate_hz, commits, recomputed_rows: recomputed })
+    let waits: Vec<f64> = commit_t.iter().enumerate().map(|(f, &t)| (t.saturating_sub(f)) as f64 / x.rate_hz).collect();
+    let committed_early: Vec<f64> =
+        commit_t.iter().enumerate().filter(|(_, &t)| t + 1 < t_len as usize).map(|(f, _)| waits[f]).collect();
+    Ok(Streamed {
+        it,
+        lag_frames: lag,
+        latency_s: lag as f64 / x.rate_hz,
+        latency_max_s: geom_core::stats::max(&committed_early),
+        latency_median_s: geom_core::stats::median(&committed_early),
+        commits,
+        recomputed_rows: recomputed,
+    })
 }
 
 #[cfg(test)]
@@ -339,6 +368,9 @@ mod tests {
         let (a, b) = (run(1), run(2));
         assert!(a.commits > 3, "{} commits", a.commits);
         assert_eq!(a.latency_s, 0.5);
+        // No frame is committed before the lag, none waits more than the lag plus one segment.
+        let dmax = crate::dp::columns(&db, p.stretch_limit_s).iter().map(|c| c.d).max().unwrap();
+        assert!(a.latency_max_s >= 0.5 && a.latency_max_s <= (5 + dmax) as f64 / 10.0, "{}", a.latency_max_s);
         assert!(a.it.score >= off.score - 1e-9 * off.score.abs());
         for w in a.it.segments.windows(2) {
             assert_eq!(w[0].end, w[1].start, "segments must share their boundary");

@@ -7,13 +7,15 @@
 //! hand snap ([`crate::handhold::close_hands`]). The whole study is repeated for every toggle-cue
 //! amplitude (spec: 0.03, 0.06, 0.12 m; keys `cue_<mm>mm_*`); the unprefixed keys are those of
 //! `duet.toggle_cue_m`. At that cue the fixed-lag streaming DP ([`crate::stream`]) runs beside the
-//! offline DP on every test dance and its label agreement is reported.
+//! offline DP on every test dance and its label agreement (per working frame, dance labels) is
+//! reported, with its nominal lag and its measured latency (the longest wait of a frame for its
+//! commit, `streaming_latency_s`).
 //!
 //! These figures check the pipeline on generated data (the generator is not tuned to them; spec
 //! §6 PC-4): they depend on the cue amplitudes, the toggle rule and the noise.
 //!
 //! Outputs: tables `dances` (one row per cue and test dance), `confusion` (true label × output
-//! label, at the main cue), plots `labels` (true and output label of every two-beat segment of the
+//! label, at the main cue), `streaming` (every lag of `streaming_lag_sweep_s` on every test dance), plots `labels` (true and output label of every two-beat segment of the
 //! first test dance) and `held_hand` (gap over time, first test dance).
 //!
 //! ```no_run
@@ -65,6 +67,9 @@ pub struct Params {
     pub dp: DpParams,
     /// Lag of the streaming DP (s).
     pub streaming_lag_s: f64,
+    /// Further lags (s) run on every test dance at the main cue for the table `streaming`.
+    #[serde(default)]
+    pub streaming_lag_sweep_s: Vec<f64>,
     /// Ramp of the hand snap (frames at the full rate).
     pub ik_ramp_frames: usize,
 }
@@ -84,7 +89,9 @@ struct CueResult {
     columns: usize,
     stream_agree: (usize, usize),
     stream_excess: Vec<f64>,
+    stream_lag_s: f64,
     stream_latency_s: f64,
+    stream_latency_median: Vec<f64>,
 }
 
 fn study(
@@ -141,6 +148,22 @@ fn study(
         )?;
         if main {
             stream(&mut r, &w, take, &d, &p.dp, lag)?;
+            for &extra in &p.streaming_lag_sweep_s {
+                let lag = (extra * w.db.working_rate_hz).floor() as usize;
+                let mut e = CueResult::default();
+                stream(&mut e, &w, take, &d, &p.dp, lag)?;
+                rec.row(
+                    "streaming",
+                    &[
+                        Cell::Int(k as i64),
+                        e.stream_lag_s.into(),
+                        (e.stream_agree.0 as f64 / e.stream_agree.1 as f64).into(),
+                        e.stream_excess[0].into(),
+                        e.stream_latency_s.into(),
+                        e.stream_latency_median[0].into(),
+                    ],
+                )?;
+            }
         }
     }
     Ok((r, w, train))
@@ -155,7 +178,9 @@ fn stream(r: &mut CueResult, w: &PreparedDb, take: &Take, d: &DrivenPoints, dp: 
     let agree = a.iter().zip(&b).filter(|(x, y)| x.dance() == y.dance()).count();
     r.stream_agree = (r.stream_agree.0 + agree, r.stream_agree.1 + a.len().min(b.len()));
     r.stream_excess.push((s.it.score - d.coarse.score) / d.coarse.score);
-    r.stream_latency_s = s.latency_s;
+    r.stream_lag_s = s.latency_s;
+    r.stream_latency_s = geom_core::stats::nan_max(r.stream_latency_s, s.latency_max_s);
+    r.stream_latency_median.push(s.latency_median_s);
     Ok(())
 }
 
@@ -216,6 +241,10 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         });
     }
     rec.table("dances", &["cue_m", "dance", "bpm", "patterns", "two_beat_errors", "segments_out", "dp_s"])?;
+    rec.table(
+        "streaming",
+        &["dance", "lag_s", "label_agreement", "score_excess_rel", "latency_max_s", "latency_median_s"],
+    )?;
     let basic = basic_patterns();
     let mut r = Report::default();
     for (i, &cue) in p.toggle_cues_m.iter().enumerate() {
@@ -258,7 +287,9 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         r.num("held_gap_cm_post", 100.0 * mean(&c.gaps[1]));
         r.num("held_gap_cm_ik", 100.0 * mean(&c.gaps[2]));
         r.num("streaming_label_agreement", c.stream_agree.0 as f64 / c.stream_agree.1 as f64);
+        r.num("streaming_lag_s", c.stream_lag_s);
         r.num("streaming_latency_s", c.stream_latency_s);
+        r.num("streaming_latency_median_s", median(&c.stream_latency_median));
         r.num("streaming_score_excess_rel", mean(&c.stream_excess));
         r.timing("dp_s", c.dp_s);
         r.timing("refine_s", c.refine_s);
