@@ -53,8 +53,8 @@ pub struct Streamed {
     pub it: Interpretation,
     /// The lag (working frames).
     pub lag_frames: usize,
-    /// The nominal latency of the output behind the control (s) = `lag / rate`: no frame is
-    /// committed earlier.
+    /// The nominal latency of the output behind the control (s) = `lag / rate`: the decision
+    /// delay of the segment covering frame `t − lag` (later frames of that segment wait less).
     pub latency_s: f64,
     /// The measured latency: the longest wait (s) between a frame's arrival and its commit, over
     /// the frames committed before the end of the input (NaN when none was). Larger than
