@@ -18,7 +18,7 @@ fn root() -> PathBuf {
 fn scene(name: &str) -> search::Params {
     let mut p: search::Params =
         load_params(&root().join("scenes/motion-graph").join(format!("{name}.ron"))).unwrap_or_else(|e| panic!("{e}"));
-    p.resolve_paths(&root());
+    p.resolve_paths(&root().join("scenes/motion-graph"));
     p
 }
 
@@ -124,7 +124,7 @@ fn a_missing_motion_file_is_a_clear_error() {
     if let search::Source::Bvh { path, .. } = &mut p.database.sources[0] {
         *path = "/nonexistent/clip.bvh".into();
     }
-    let e = search::run(&p, Size::Tiny, &mut NullRecorder::default()).err().expect("must fail");
+    let Err(e) = search::run(&p, Size::Tiny, &mut NullRecorder::default()) else { panic!("must fail") };
     assert!(e.to_string().contains("/nonexistent/clip.bvh"), "{e}");
 }
 

@@ -60,7 +60,7 @@ fn mouse_paths_pc3() {
 #[test]
 fn real_data_pc6() {
     let mut p: real_data::Params = load_params(&scene("real-data")).unwrap();
-    p.resolve_paths(&root());
+    p.resolve_paths(&root().join("scenes/perf-control"));
     let r = tests::assert_thread_independent("real-data", || {
         real_data::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap()
     });

@@ -52,7 +52,8 @@ pub struct Params {
 }
 
 impl Params {
-    /// Resolves relative BVH paths against `root` (the workspace root for the built-in scene).
+    /// Resolves relative BVH paths against `root` (the scene file's folder: the built-in scene
+    /// names `../../assets/mocap/…`).
     pub fn resolve_paths(&mut self, root: &Path) {
         for p in [&mut self.train, &mut self.split] {
             if Path::new(p.as_str()).is_relative() {

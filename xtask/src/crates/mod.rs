@@ -2,5 +2,7 @@
 //! experiment with a file recorder ([`crate::record::run_experiment`]) and returns the figures
 //! of `summary.json`. Each module's `register` adds its runners.
 
+pub mod flip_tet;
 pub mod motion_graph;
 pub mod perf_control;
+pub mod rigging;

@@ -1,8 +1,9 @@
 //! perf-control's adapter: one runner per experiment of `perf_control::experiments` (PC-1 walk,
-//! PC-2 walk timing, PC-3 mouse paths, PC-4 dance, PC-5 dance timing, PC-6 real data), each loading the scene's `params` block
-//! and calling the experiment with a file recorder (tables `metrics.csv`, `timing.csv`,
-//! `segments.csv`, `target_points.csv`, `dances.csv`, `confusion.csv`, plots `topview.png`,
-//! `time_vs_length.png`, `labels.png`, `held_hand.png`, `target.bvh`).
+//! PC-2 walk timing, PC-3 mouse paths, PC-4 dance, PC-5 dance timing, PC-6 real data), each
+//! loading the scene's `params` block and calling the experiment with a file recorder (tables
+//! `metrics.csv`, `timing.csv`, `segments.csv`, `target_points.csv`, `dances.csv`,
+//! `confusion.csv`, `streaming.csv`, plots `topview.png`, `time_vs_length.png`, `labels.png`,
+//! `held_hand.png`, `target.bvh`).
 
 use perf_control::experiments::{dance, dance_timing, mouse_paths, real_data, walk, walk_timing};
 
@@ -27,7 +28,8 @@ pub fn register(v: &mut Vec<Runner>) {
     v.push(Runner { method: "perf-control/dance-timing", run: |ctx| run_experiment(ctx, dance_timing::run) });
 }
 
-/// PC-6: the BVH paths of the scene file are relative to the workspace root.
+/// PC-6: the BVH paths of the scene file are relative to its folder (`workspace_root()` is the
+/// running scene's folder, `crate::paths::relative_base`).
 fn run_real(ctx: &RunCtx) -> Result<Summary> {
     run_experiment(ctx, |p: &real_data::Params, size, rec| {
         let mut p = p.clone();
