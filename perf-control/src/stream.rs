@@ -264,9 +264,8 @@ pub fn interpret_streaming(db: &MappingDb, x: &PointTrack, p: &DpParams, lag: us
         committed.extend_from_slice(&chain[..=upto]);
         let (col, start) = chain[upto];
         let e = (start + st.cols[col].d as i64) as usize;
-        for g in (committed_until + 1).max(0) as usize..=e.min(t_len as usize - 1) {
-            commit_t[g] = t;
-        }
+        let first = (committed_until + 1).max(0) as usize;
+        commit_t[first..=e.min(t_len as usize - 1)].fill(t);
         frontier = Some((e, col));
         committed_until = e as i64;
         commits += 1;

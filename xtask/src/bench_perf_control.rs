@@ -7,21 +7,25 @@
 //!   RMS with refinement on, and the coarse-only tracking RMS (refinement off);
 //! - `cluster`: database size (all, 140, 100, 70, 50, 35), both distance modes: time vs error;
 //! - `stretch`: stretch limit 0 … 0.3 s: time (P grows) vs error;
-//! - `k`: continuity constant 0 … 100: tracking error and seam jumps (quality only).
+//! - `k`: continuity constant 0 … 100: tracking error and seam jumps (quality only);
+//! - `dance`: the dance rows — beam width w ∈ {0, 0.1, 0.3, 1, 3, 10, ∞} on the PC-4 database and
+//!   first test dance: DP wall and CPU time vs score excess and two-beat error rate, and whether
+//!   the labels equal the exact run's (`pc_dance.csv`, `pc_dance.png`;
+//!   [`perf_control::experiments::sweeps::evaluate_dance`]).
 //!
 //! Every point is one call of [`perf_control::experiments::sweeps::evaluate`]. Writes
 //! `pc_<sweep>.csv` and `pc_<sweep>.png` per sweep.
 
-use perf_control::experiments::sweeps::{evaluate, SweepPoint, WalkSweep};
+use perf_control::experiments::sweeps::{evaluate, evaluate_dance, DanceSweep, SweepPoint, WalkSweep};
 use perf_control::{ClusterDistance, DpParams};
 
 use crate::error::{Error, Result};
-use crate::out::{CsvWriter, Summary};
+use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
 use crate::registry::BenchCtx;
 
 /// The sweeps `--sweep` accepts.
-pub const SWEEPS: &[&str] = &["beam", "rate", "cluster", "stretch", "k"];
+pub const SWEEPS: &[&str] = &["beam", "rate", "cluster", "stretch", "k", "dance"];
 
 /// The CSV columns of every sweep.
 const HEADER: [&str; 10] = [
@@ -66,6 +70,11 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     summary.set_str("mode", if quick { "quick" } else { "default" });
     let cat = ClusterDistance::ControlAndTarget;
     for sw in sel {
+        if sw == "dance" {
+            dance(ctx, &mut summary)?;
+            summary.set_count("dance_done", 1);
+            continue;
+        }
         let mut csv = CsvWriter::create(&ctx.out_dir.join(format!("pc_{sw}.csv")), &HEADER)?;
         // The walk defaults of spec §4 (k = 10, ±0.2 s, exact, partial ends); PC-1's database size.
         let p0 = DpParams::default();
@@ -153,4 +162,46 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
         summary.set_count(&format!("{sw}_done"), 1);
     }
     Ok(summary)
+}
+
+/// The dance rows (spec §9): beam widths on the PC-4 database and first test dance.
+fn dance(ctx: &BenchCtx, summary: &mut Summary) -> Result<()> {
+    let s = DanceSweep::new(ctx.quick)?;
+    let header = [
+        "w",
+        "dp_s",
+        "dp_cpu_s",
+        "score",
+        "score_excess_rel",
+        "two_beat_error_rate",
+        "labels_as_exact",
+        "cells_expanded",
+    ];
+    let mut csv = CsvWriter::create(&ctx.out_dir.join("pc_dance.csv"), &header)?;
+    let p0 = DpParams { stretch_limit_s: 0.15, ..DpParams::default() };
+    let exact = evaluate_dance(&s, &p0)?;
+    let (mut wall, mut cpu) = (Vec::new(), Vec::new());
+    for w in [0.0, 0.1, 0.3, 1.0, 3.0, 10.0, f64::INFINITY] {
+        let r = evaluate_dance(&s, &DpParams { beam: Some(w), ..p0.clone() })?;
+        let excess = (r.score - exact.score) / exact.score;
+        csv.row(&[
+            w.into(),
+            r.dp_s.into(),
+            r.dp_cpu_s.into(),
+            r.score.into(),
+            excess.into(),
+            r.two_beat_error_rate.into(),
+            Cell::Int(i64::from(r.labels == exact.labels)),
+            Cell::Int(r.cells_expanded as i64),
+        ])?;
+        wall.push((r.dp_s, excess.max(1e-9)));
+        cpu.push((r.dp_cpu_s, excess.max(1e-9)));
+    }
+    summary.set("dance_exact_two_beat_error_rate", exact.two_beat_error_rate);
+    LinePlot::new("perf-control: dance beam sweep", "DP time (s)", "relative score excess (floored at 1e-9)")
+        .log(false, true)
+        .with(Series::new("wall", wall))
+        .with(Series::new("CPU", cpu))
+        .write_png(&ctx.out_dir.join("pc_dance.png"))?;
+    Ok(())
 }

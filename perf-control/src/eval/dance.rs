@@ -216,7 +216,7 @@ mod tests {
         assert_eq!(s.novel(&basic_patterns()), 0, "both patterns are basic");
         assert_eq!(s.novel(&[]), 2);
         let mut s = Semantics::default();
-        s.add(&t, &vec![None; 8]);
+        s.add(&t, &[None; 8]);
         assert_eq!(s.segment_errors, 8);
     }
 
