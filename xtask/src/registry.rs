@@ -84,7 +84,7 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::curve_skin::register(&mut v);
     crate::crates::rigging::register(&mut v);
     crate::crates::motion_graph::register(&mut v);
-    crate::scenes::perf_control::register(&mut v);
+    crate::crates::perf_control::register(&mut v);
     crate::crates::flip_tet::register(&mut v);
     crate::scenes::wrinkles::register(&mut v);
     v

@@ -4,4 +4,5 @@
 
 pub mod flip_tet;
 pub mod motion_graph;
+pub mod perf_control;
 pub mod rigging;

@@ -3,7 +3,6 @@
 pub mod barnet;
 pub mod curve_skin;
 pub mod geom_core;
-pub mod perf_control;
 pub mod shells;
 pub mod tracks;
 pub mod tracks_variants;

@@ -1,8 +1,15 @@
-//! Evaluation metrics (spec §3.14): control tracking, gait frequency and phase, seam jumps.
+//! Evaluation metrics (spec §3.14): control tracking, gait frequency and phase, seam jumps;
+//! [`path`] the path-following figures of PC-3; [`dance`] the dance semantics of PC-4.
+
+pub mod dance;
+pub mod path;
+
+pub use path::{fastest_step_speed, intrinsic_speed, path_following, seam_frames, PathFollowing};
 
 use crate::track::PointTrack;
 use geom_core::anim::{FrameLabels, Motion};
 use geom_core::math::wrap_angle;
+use geom_core::stats::{median, nan_max};
 use serde::{Deserialize, Serialize};
 
 /// Tracking error of a 2-point floor control (`[left, right]`).
@@ -31,7 +38,7 @@ pub fn tracking_error(requested: &PointTrack, achieved: &PointTrack) -> Tracking
         let mb = (b[0] + b[1]) * 0.5;
         let d = ((ma.x - mb.x).powi(2) + (ma.z - mb.z).powi(2)).sqrt();
         s2 += d * d;
-        mx = mx.max(d);
+        mx = nan_max(mx, d);
         let ea = a[0] - a[1];
         let eb = b[0] - b[1];
         let dh = wrap_angle(ea.x.atan2(ea.z) - eb.x.atan2(eb.z));
@@ -95,15 +102,14 @@ pub fn phase_agreement(a: &Motion, b: &Motion) -> f64 {
 }
 
 /// Largest point jump `max_p ‖x_{f} − x_{f−1}‖` (m) at each of the given frames, and the median
-/// frame-to-frame jump elsewhere (a seam-quality indicator for point output).
+/// frame-to-frame jump elsewhere (a seam-quality indicator for point output; NaN when there is no
+/// other frame). A NaN coordinate makes the jumps NaN.
 pub fn seam_jumps(t: &PointTrack, seams: &[usize]) -> (Vec<f64>, f64) {
     let jump = |f: usize| -> f64 {
         let (a, b) = (t.frame(f - 1), t.frame(f));
-        a.iter().zip(b).map(|(p, q)| (p - q).norm()).fold(0.0, f64::max)
+        a.iter().zip(b).map(|(p, q)| (p - q).norm()).fold(0.0, nan_max)
     };
     let js: Vec<f64> = seams.iter().filter(|&&f| f >= 1 && f < t.len()).map(|&f| jump(f)).collect();
-    let mut others: Vec<f64> = (1..t.len()).filter(|f| !seams.contains(f)).map(jump).collect();
-    others.sort_by(f64::total_cmp);
-    let med = if others.is_empty() { 0.0 } else { others[others.len() / 2] };
-    (js, med)
+    let others: Vec<f64> = (1..t.len()).filter(|f| !seams.contains(f)).map(jump).collect();
+    (js, median(&others))
 }
