@@ -64,7 +64,8 @@ pub fn contraction_ratios(history: &[f64]) -> Vec<f64> {
 /// gives 2, a linearly converging method 1 (C is then its contraction ratio). NaN with fewer than
 /// two such pairs.
 pub fn convergence_order(history: &[f64], floor: f64) -> f64 {
-    let pairs: Vec<(f64, f64)> = history.windows(2).filter(|w| w[0] > floor && w[1] > floor).map(|w| (w[0], w[1])).collect();
+    let pairs: Vec<(f64, f64)> =
+        history.windows(2).filter(|w| w[0] > floor && w[1] > floor).map(|w| (w[0], w[1])).collect();
     geom_core::stats::loglog_fit(&pairs).1
 }
 

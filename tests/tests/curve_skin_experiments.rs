@@ -25,7 +25,8 @@ fn arm_scene(id: &str) -> Report {
 #[test]
 fn elbow_bend() {
     let r = arm_scene("curve-skin/elbow-bend");
-    let keys = ["lbs_joint_radius_ratio", "dqs_joint_radius_ratio", "curve_max_dist_over_r", "curve_max_dist_over_r_f64"];
+    let keys =
+        ["lbs_joint_radius_ratio", "dqs_joint_radius_ratio", "curve_max_dist_over_r", "curve_max_dist_over_r_f64"];
     assert_these_checks_pass("elbow-bend", &r, &keys);
     assert_these_checks_pass("elbow-bend", &r, &["curve_fold_fraction"]);
     // LBS collapses at the elbow, curve skin does not (spec §7.4 a), and the action line shortens.

@@ -44,7 +44,8 @@ fn mocap() {
 #[test]
 fn solvers() {
     let p = solvers::Params { sheet_quads: vec![7, 15], sphere_levels: vec![2], reps: 1 };
-    let r = assert_thread_independent("solvers", || solvers::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap());
+    let r =
+        assert_thread_independent("solvers", || solvers::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap());
     assert!(r.get_f64("max_residual_direct") <= solvers::MAX_DIRECT_RESIDUAL);
     assert!(r.get_f64("kkt_residual") < 1e-8);
     assert_eq!(r.get_f64("largest_sheet_n"), 256.0);

@@ -14,9 +14,7 @@ use curve_skin::curve::CurveShape;
 use curve_skin::experiments::perf::time_frames;
 use curve_skin::metrics::{max_rms_error, signed_volume, to_f64};
 use curve_skin::poses::{axis_deg, walk_pose};
-use curve_skin::presets::{
-    arm_pose, capsule_character, curve_skeleton, ramp_weights4, reference_arm, ARM_RADIUS,
-};
+use curve_skin::presets::{arm_pose, capsule_character, curve_skeleton, ramp_weights4, reference_arm, ARM_RADIUS};
 use curve_skin::{CurveOptions, CurveSkin, Dqs, Lbs, PackedWeights, SkinWeights, Skinner};
 use geom_core::math::{Pt3, Vec3};
 use geom_core::stats::nan_max;
@@ -167,6 +165,12 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
         summary.set(&format!("{m}_bend90_volume_error"), verr);
         summary.set(&format!("{m}_ns_per_vertex"), dt / n as f64 * 1e9);
     }
-    plot("volume error vs cost (arm bent 90°)", "ns per vertex", "|V/V0 − 1|", pareto, &ctx.out_dir.join("pareto.png"))?;
+    plot(
+        "volume error vs cost (arm bent 90°)",
+        "ns per vertex",
+        "|V/V0 − 1|",
+        pareto,
+        &ctx.out_dir.join("pareto.png"),
+    )?;
     Ok(summary)
 }

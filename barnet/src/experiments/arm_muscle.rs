@@ -58,13 +58,7 @@ pub struct Params {
 }
 
 fn series(plot: &str, label: String, y: &str, points: Vec<(f64, f64)>) -> Series {
-    Series {
-        plot: plot.into(),
-        label,
-        axes: ("elbow flexion (deg)".into(), y.into()),
-        log: (false, false),
-        points,
-    }
+    Series { plot: plot.into(), label, axes: ("elbow flexion (deg)".into(), y.into()), log: (false, false), points }
 }
 
 /// Runs the sweep for every q; see the module docs.

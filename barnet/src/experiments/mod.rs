@@ -74,7 +74,13 @@ fn poly_frame(rec: &mut dyn Recorder, seq: &str, frame: usize, p: Positions, fac
 }
 
 /// [`poly_frame`] of a fine mesh (f32 positions).
-pub(crate) fn fine_frame(rec: &mut dyn Recorder, seq: &str, f: usize, p: &[[f32; 3]], faces: &Ragged<u32>) -> Result<()> {
+pub(crate) fn fine_frame(
+    rec: &mut dyn Recorder,
+    seq: &str,
+    f: usize,
+    p: &[[f32; 3]],
+    faces: &Ragged<u32>,
+) -> Result<()> {
     poly_frame(rec, seq, f, Positions::F32(p), faces)
 }
 

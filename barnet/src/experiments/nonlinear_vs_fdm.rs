@@ -109,8 +109,7 @@ pub fn run(p: &Params, _size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         (0.0, 0, true, f64::NAN, f64::NAN);
     for (li, &lam) in p.load_scales.iter().enumerate() {
         rec.progress(li as u64, p.load_scales.len() as u64);
-        let loads: Vec<Vec3> =
-            p0.iter().zip(&an.biceps_pattern).map(|(a, b)| a + b * (lam * p.base_load)).collect();
+        let loads: Vec<Vec3> = p0.iter().zip(&an.biceps_pattern).map(|(a, b)| a + b * (lam * p.base_load)).collect();
         let mut x = Vec::new();
         let mut tf = Vec::new();
         let mut info = SolveInfo::default();

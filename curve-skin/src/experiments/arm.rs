@@ -171,7 +171,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         methods.push(ArmMethod { name: format!("lbs_{tag}"), skinner: Box::new(lbs), curve: false, twin: None });
         methods.push(ArmMethod { name: format!("dqs_{tag}"), skinner: Box::new(dqs), curve: false, twin: None });
     }
-    let new_curve = |cskel: &CurveSkeleton, o: CurveOptions| CurveSkin::new(&sk, cskel.clone(), &mesh.positions, None, o);
+    let new_curve =
+        |cskel: &CurveSkeleton, o: CurveOptions| CurveSkin::new(&sk, cskel.clone(), &mesh.positions, None, o);
     let cskel = curve_skeleton(&sk, p.shapes[0]);
     methods.push(ArmMethod {
         name: "curve".into(),
@@ -183,7 +184,12 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         volume_comp: VolumeComp::Isotropic { max_scale: p.comp_max_scale.unwrap_or(f64::INFINITY) },
         ..Default::default()
     };
-    methods.push(ArmMethod { name: "curve_comp".into(), skinner: Box::new(new_curve(&cskel, comp)?), curve: true, twin: None });
+    methods.push(ArmMethod {
+        name: "curve_comp".into(),
+        skinner: Box::new(new_curve(&cskel, comp)?),
+        curve: true,
+        twin: None,
+    });
     for &shape in &p.shapes[1..] {
         let name = match shape {
             CurveShape::CircularArc => "curve_arc",
@@ -381,7 +387,11 @@ fn add_checks(p: &Params, rep: &mut Report) {
         ArmMotion::Bend => {
             let cf = lbs_joint_radius_ratio(p.summary_deg.to_radians());
             if has(rep, "lbs_joint_radius_ratio") {
-                rep.check("lbs_joint_radius_ratio", Target::Within(cf - 0.01, cf + 0.01), "spec §7.2 a: cos(β/2) ± 0.01 (reference mesh 400 × 96)");
+                rep.check(
+                    "lbs_joint_radius_ratio",
+                    Target::Within(cf - 0.01, cf + 0.01),
+                    "spec §7.2 a: cos(β/2) ± 0.01 (reference mesh 400 × 96)",
+                );
             }
             for m in ["curve", "dqs"] {
                 let k = format!("{m}_joint_radius_ratio");
@@ -399,14 +409,26 @@ fn add_checks(p: &Params, rep: &mut Report) {
         }
         ArmMotion::Twist => {
             if has(rep, "curve_volume_ratio") {
-                rep.check("curve_volume_ratio", Target::AtLeast(0.999), "spec §7.4: pure twist V/V0 ≥ 0.999 (reference mesh 400 × 96)");
+                rep.check(
+                    "curve_volume_ratio",
+                    Target::AtLeast(0.999),
+                    "spec §7.4: pure twist V/V0 ≥ 0.999 (reference mesh 400 × 96)",
+                );
             }
             if has(rep, "dqs_volume_ratio") {
-                rep.check("dqs_volume_ratio", Target::Within(0.999, 1.001), "spec §7.3 d: DQS twist V/V0 = 1 ± 1e-3 (reference mesh 400 × 96)");
+                rep.check(
+                    "dqs_volume_ratio",
+                    Target::Within(0.999, 1.001),
+                    "spec §7.3 d: DQS twist V/V0 = 1 ± 1e-3 (reference mesh 400 × 96)",
+                );
             }
             let cf = rep.get_f64("lbs_closed_form_volume_ratio");
             if has(rep, "lbs_volume_ratio") && cf.is_finite() {
-                rep.check("lbs_volume_ratio", Target::Within(cf - 2e-3, cf + 2e-3), "spec §7.2 c: closed form ± 2e-3 (reference mesh 400 × 96)");
+                rep.check(
+                    "lbs_volume_ratio",
+                    Target::Within(cf - 2e-3, cf + 2e-3),
+                    "spec §7.2 c: closed form ± 2e-3 (reference mesh 400 × 96)",
+                );
             }
         }
     }

@@ -76,9 +76,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let mut out = vec![[0f32; 3]; n];
     for (pi, name) in p.poses.iter().enumerate() {
         rec.progress(pi as u64, p.poses.len() as u64);
-        let pose = humanoid_pose(&c.sk, name).ok_or_else(|| {
-            SkinError::Param(format!("unknown pose '{name}' (known: {})", HUMANOID_POSES.join(", ")))
-        })?;
+        let pose = humanoid_pose(&c.sk, name)
+            .ok_or_else(|| SkinError::Param(format!("unknown pose '{name}' (known: {})", HUMANOID_POSES.join(", "))))?;
         let posed = pose.globals(&c.sk);
         for (m, s) in methods.iter_mut() {
             s.prepare(&c.sk, &posed)?;

@@ -204,7 +204,18 @@ pub struct MethodRow {
 impl MethodRow {
     fn direct(method: &str, setup_s: f64, factor_s: f64, solve_s: f64, rel_residual: f64, nnz_l: usize) -> Self {
         let total_s = setup_s + factor_s + solve_s;
-        MethodRow { method: method.into(), tol: 0.0, setup_s, factor_s, solve_s, total_s, iters: 0, rel_residual, rel_error: 0.0, nnz_l }
+        MethodRow {
+            method: method.into(),
+            tol: 0.0,
+            setup_s,
+            factor_s,
+            solve_s,
+            total_s,
+            iters: 0,
+            rel_residual,
+            rel_error: 0.0,
+            nnz_l,
+        }
     }
 }
 
@@ -390,8 +401,7 @@ pub fn run(p: &Params, _size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     for s in &series {
         rec.series(s)?;
     }
-    let (n_big, big) =
-        largest_sheet.ok_or_else(|| Error::InvalidParameter("solvers: sheet_quads is empty".into()))?;
+    let (n_big, big) = largest_sheet.ok_or_else(|| Error::InvalidParameter("solvers: sheet_quads is empty".into()))?;
     let mut s = Report::default();
     let speedup = big.full_s / big.refactor_s;
     s.timing("refactor_speedup", speedup);

@@ -126,7 +126,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let mut a4 = WrinkleAnimator::new(rig.clone(), base.clone())?;
     let inf = ModulationOptions { blend: BlendOptions { power: f64::INFINITY, ..blend }, ..base.clone() };
     let mut ainf = WrinkleAnimator::new(rig.clone(), inf)?;
-    let mut apl = WrinkleAnimator::new(rig.clone(), ModulationOptions { mode: ModulationMode::PrincipalLength, ..base })?;
+    let mut apl =
+        WrinkleAnimator::new(rig.clone(), ModulationOptions { mode: ModulationMode::PrincipalLength, ..base })?;
     let marked = triangle_at(&mesh, Vec2::new(p.marked[0], p.marked[1]))
         .ok_or_else(|| WrinkleError::InvalidOption(format!("marked point {:?} is outside the sheet", p.marked)))?;
     let n_frames = (4.0 * p.stage_seconds * fps).round() as usize;

@@ -163,7 +163,11 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
                     };
                     let mut a = WrinkleAnimator::new(rig.clone(), o)?;
                     let (mut hv, mut rv) = (Vec::new(), Vec::new());
-                    let row = |rec: &mut dyn Recorder, load: &str, param: f64, fr: &crate::metrics::UniaxialFrame, an: f64| {
+                    let row = |rec: &mut dyn Recorder,
+                               load: &str,
+                               param: f64,
+                               fr: &crate::metrics::UniaxialFrame,
+                               an: f64| {
                         rec.row(
                             "metrics",
                             &[
@@ -191,7 +195,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
                                 stretch_violations += 1;
                             }
                             if ang == 0.0 && fr.clipped == 0 && c < 1.0 {
-                                amp_err_max = nan_max(amp_err_max, (fr.h_mean * eta / lambda - analytic).abs() / analytic);
+                                amp_err_max =
+                                    nan_max(amp_err_max, (fr.h_mean * eta / lambda - analytic).abs() / analytic);
                             }
                         }
                         hv.push((c, fr.h_mean));
