@@ -9,8 +9,9 @@ use geom_core::experiments::{mocap, render, solvers, subdivision};
 use geom_core::record::NullRecorder;
 use tests::{assert_checks_pass, assert_thread_independent, scene_params};
 
+/// The folder of geom-core's scene files: their relative paths (`../../assets/…`) resolve there.
 fn workspace() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/geom-core")
 }
 
 #[test]
@@ -53,7 +54,7 @@ fn solvers() {
 
 #[test]
 fn missing_files_are_errors() {
-    let p = mocap::Params { clips: vec!["no/such.bvh".into()], quick_frames: 10, root: workspace() };
+    let p = mocap::Params { clips: vec!["../../assets/no/such.bvh".into()], quick_frames: 10, root: workspace() };
     let e = mocap::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap_err();
     assert!(e.to_string().contains("no/such.bvh"), "{e}");
 }

@@ -106,6 +106,13 @@ pub fn write_png_gray8(path: impl AsRef<Path>, img: &ImageF32) -> Result<()> {
     write_png(path.as_ref(), img.width, img.height, png::ColorType::Grayscale, png::BitDepth::Eight, &bytes)
 }
 
+/// Encodes an image as an 8-bit grayscale PNG in memory (the bytes [`write_png_gray8`] writes),
+/// for outputs handed to a [`crate::record::Recorder`] as files: [`encode_png_gray8`] (the name
+/// flip-tet's experiments use).
+pub fn png_gray8_bytes(img: &ImageF32) -> Result<Vec<u8>> {
+    encode_png_gray8(img)
+}
+
 /// Writes a 16-bit grayscale PNG: each value `v` becomes `round(v · scale)` clamped to
 /// `0..=65535` (NaN → 0). Use `scale = 65535` for `[0, 1]` data (then [`read_png`] returns `v` to
 /// within `1/131070`), or e.g. `scale = 1000` to store depths in millimetres.

@@ -1,6 +1,7 @@
 //! geom-core's own scenes over `geom_core::experiments`: `geom-core/render`,
 //! `geom-core/subdivision`, `geom-core/mocap`. Mesh and clip paths in the scene files are
-//! relative to the workspace root. (geom-core's error type is xtask's `Error::Core`.)
+//! relative to the scene file's folder (`out::workspace_root()` while a scene runs, as
+//! `RunCtx::resolve`). (geom-core's error type is xtask's `Error::Core`.)
 
 use geom_core::experiment::{Report, Size};
 use geom_core::experiments::{mocap, render, subdivision};

@@ -14,7 +14,10 @@ use crate::scene;
 
 pub mod barnet;
 pub mod curve_skin;
+pub mod flip_tet;
 pub mod geom_core;
+pub mod motion_graph;
+pub mod rigging;
 pub mod wrinkles;
 
 /// An experiment of a method crate: `run(&Params, Size, &mut dyn Recorder)`.
