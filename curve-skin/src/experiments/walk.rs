@@ -50,7 +50,7 @@ pub struct Params {
 
 /// Runs the walk; see the module docs.
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
-    if !(p.fps > 0.0) {
+    if p.fps.is_nan() || p.fps <= 0.0 {
         return Err(SkinError::Param(format!("fps = {} must be positive", p.fps)));
     }
     let c = capsule_character(p.resolution.get(size), HUMANOID_WEIGHT_THRESHOLD)?;

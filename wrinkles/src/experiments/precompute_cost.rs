@@ -51,7 +51,13 @@ pub struct Params {
 /// Runs the sweep; see the module docs.
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let (quads, tols, n) = (p.quads.get(size), p.tolerances.get(size), p.image.get(size));
-    if quads.is_empty() || tols.is_empty() || n == 0 || quads.contains(&0) || !(p.wavelength > 0.0) {
+    if quads.is_empty()
+        || tols.is_empty()
+        || n == 0
+        || quads.contains(&0)
+        || p.wavelength.is_nan()
+        || p.wavelength <= 0.0
+    {
         return Err(WrinkleError::InvalidOption(
             "quads, tolerances, image and wavelength must be non-empty/positive".into(),
         ));

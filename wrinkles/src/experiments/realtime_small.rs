@@ -58,7 +58,7 @@ pub struct Params {
 /// Runs the animation; see the module docs.
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let frames = p.frames.get(size).max(1);
-    if !(p.size > 0.0) || p.quads == 0 || p.level == 0 || p.preview.contains(&0) {
+    if p.size.is_nan() || p.size <= 0.0 || p.quads == 0 || p.level == 0 || p.preview.contains(&0) {
         return Err(WrinkleError::InvalidOption("size, quads, level and preview must be positive".into()));
     }
     let mesh = sheet(p.quads, p.size)?;
