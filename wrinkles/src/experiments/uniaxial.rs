@@ -112,7 +112,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let (slopes, angles, tolerance) = (p.slopes.get(size), p.angles_deg.get(size), p.tolerance.get(size));
     if !(p.size > 0.0 && p.periods > 0.0 && tolerance > 0.0 && p.max_slope > 0.0)
         || slopes.is_empty()
-        || slopes.iter().any(|s| !(*s > 0.0))
+        || slopes.iter().any(|s| s.is_nan() || *s <= 0.0)
     {
         return Err(WrinkleError::InvalidOption(
             "size, periods, tolerance, max_slope and slopes must be positive (at least one slope)".into(),
