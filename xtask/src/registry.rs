@@ -76,17 +76,17 @@ pub struct Bench {
 /// Every scene runner of every crate.
 pub fn runners() -> Vec<Runner> {
     let mut v = Vec::new();
-    crate::scenes::geom_core::register(&mut v);
-    crate::scenes::barnet::register(&mut v);
+    crate::crates::geom_core::register(&mut v);
+    crate::crates::barnet::register(&mut v);
     crate::scenes::shells::register(&mut v);
     crate::scenes::tracks::register(&mut v);
     crate::scenes::tracks_variants::register(&mut v);
-    crate::scenes::curve_skin::register(&mut v);
+    crate::crates::curve_skin::register(&mut v);
     crate::crates::rigging::register(&mut v);
     crate::crates::motion_graph::register(&mut v);
     crate::crates::perf_control::register(&mut v);
     crate::crates::flip_tet::register(&mut v);
-    crate::scenes::wrinkles::register(&mut v);
+    crate::crates::wrinkles::register(&mut v);
     v
 }
 

@@ -1,9 +1,5 @@
 //! Scene runners, one module per crate. Each module's `register` adds its runners.
 
-pub mod barnet;
-pub mod curve_skin;
-pub mod geom_core;
 pub mod shells;
 pub mod tracks;
 pub mod tracks_variants;
-pub mod wrinkles;
