@@ -23,7 +23,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let truth = FabricPreset::Linen.params();
     let space = ParamSpace::new(default_ranges(), ParamId::ALL.to_vec(), truth)?;
     let fwd = ShellsForward;
-    for (name, e) in [("static", static_trial(FabricPreset::Linen, 0, 5)), ("waving", waving_trial(FabricPreset::Linen, 0, 50))] {
+    for (name, e) in
+        [("static", static_trial(FabricPreset::Linen, 0, 5)), ("waving", waving_trial(FabricPreset::Linen, 0, 50))]
+    {
         let src = SyntheticSource::new(Condition::Matched, truth, &setup, NoiseModel::default());
         let t = synthesize(&fwd, &e, &setup.rig, &src, &setup.angle)?;
         let targets = [t.target];

@@ -177,29 +177,29 @@ fn orientation_window(img: &ImageF32, out: Rect, o: &AngleOptions) -> (Vec<f32>,
         }
     }
     // 3. Gaussian blur of C2, C3 (separable, clamped at the image border) on the output window.
+    let (ow, oh) = (out.w(), out.h());
     let blur = |c: &[f64]| -> Vec<f64> {
-        let mut tmp = vec![0.0f64; cww * cwh];
+        // Along x for the output columns over every coefficient row, then along y.
+        let mut tmp = vec![0.0f64; ow * cwh];
         for yy in 0..cwh {
-            for xx in 0..cww {
-                let x = cw.x0 + xx as i64;
+            for xx in 0..ow {
+                let x = out.x0 + xx as i64;
                 let mut a = 0.0;
                 for (k, wk) in bk.iter().enumerate() {
                     let xs = clampx(x + k as i64 - rb);
                     a += wk * c[yy * cww + (xs - cw.x0) as usize];
                 }
-                tmp[yy * cww + xx] = a;
+                tmp[yy * ow + xx] = a;
             }
         }
-        let (ow, oh) = (out.w(), out.h());
         let mut res = vec![0.0f64; ow * oh];
         for yy in 0..oh {
             let y = out.y0 + yy as i64;
             for xx in 0..ow {
-                let x = out.x0 + xx as i64;
                 let mut a = 0.0;
                 for (k, wk) in bk.iter().enumerate() {
                     let ys = clampy(y + k as i64 - rb);
-                    a += wk * tmp[((ys - cw.y0) as usize) * cww + (x - cw.x0) as usize];
+                    a += wk * tmp[((ys - cw.y0) as usize) * ow + xx];
                 }
                 res[yy * ow + xx] = a;
             }
@@ -210,11 +210,8 @@ fn orientation_window(img: &ImageF32, out: Rect, o: &AngleOptions) -> (Vec<f32>,
     // 4. Dominant orientation θ_d = ½ atan2(C3, C2), the direction of the intensity variation;
     //    the stripes run perpendicular to it: θ = wrap_π(θ_d + π/2 + c0), c0 = 0 (fixed by the
     //    grating test T6: a grating along the screen direction φ gives θ = φ).
-    let theta: Vec<f32> = b2
-        .iter()
-        .zip(&b3)
-        .map(|(&a, &b)| wrap_pi(0.5 * b.atan2(a) + std::f64::consts::FRAC_PI_2) as f32)
-        .collect();
+    let theta: Vec<f32> =
+        b2.iter().zip(&b3).map(|(&a, &b)| wrap_pi(0.5 * b.atan2(a) + std::f64::consts::FRAC_PI_2) as f32).collect();
     let strength: Vec<f32> = b2.iter().zip(&b3).map(|(&a, &b)| a.hypot(b) as f32).collect();
     (theta, strength)
 }
@@ -259,8 +256,7 @@ pub fn angle_map(img: &ImageF32, sil: &Mask, o: &AngleOptions) -> AngleFrame {
         strength.data[row..row + ow].copy_from_slice(&s[yy * ow..(yy + 1) * ow]);
     }
     // Validity: eroded silhouette and enough strength.
-    let inside: Vec<f64> =
-        sil.data.iter().zip(&strength.data).filter(|(m, _)| **m).map(|(_, &v)| v as f64).collect();
+    let inside: Vec<f64> = sil.data.iter().zip(&strength.data).filter(|(m, _)| **m).map(|(_, &v)| v as f64).collect();
     let cut = o.min_strength * median(&inside);
     let er = erode(sil, o.erosion_px);
     let valid = Mask {

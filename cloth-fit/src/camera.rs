@@ -102,8 +102,8 @@ mod tests {
     /// Spec T1: look_at → project against hand-computed pixels; decompose ∘ from_krt = id.
     #[test]
     fn look_at_projects_and_decomposes() {
-        let c = Camera::look_at(&Pt3::new(0.0, -1.2, 0.0), &Pt3::new(0.0, 0.0, 0.0), &Vec3::z(), 60.0, 320, 240)
-            .unwrap();
+        let c =
+            Camera::look_at(&Pt3::new(0.0, -1.2, 0.0), &Pt3::new(0.0, 0.0, 0.0), &Vec3::z(), 60.0, 320, 240).unwrap();
         // f = 120 / tan 30°; a point 0.1 m right and 0.05 m up at depth 1.2 m.
         let f = 120.0 / 30f64.to_radians().tan();
         let (px, w) = c.project(&Pt3::new(0.1, 0.0, 0.05)).unwrap();

@@ -53,24 +53,8 @@ pub fn calibrate_dlt(world: &[Pt3], image: &[Pt2], width: u32, height: u32) -> R
     }
     let (s2, s3) = (2f64.sqrt() / d2, 3f64.sqrt() / d3);
     let t2 = Mat3::new(s2, 0.0, -s2 * c2.x, 0.0, s2, -s2 * c2.y, 0.0, 0.0, 1.0);
-    let t3 = Matrix4::new(
-        s3,
-        0.0,
-        0.0,
-        -s3 * c3.x,
-        0.0,
-        s3,
-        0.0,
-        -s3 * c3.y,
-        0.0,
-        0.0,
-        s3,
-        -s3 * c3.z,
-        0.0,
-        0.0,
-        0.0,
-        1.0,
-    );
+    let t3 =
+        Matrix4::new(s3, 0.0, 0.0, -s3 * c3.x, 0.0, s3, 0.0, -s3 * c3.y, 0.0, 0.0, s3, -s3 * c3.z, 0.0, 0.0, 0.0, 1.0);
     let mut a = DMatrix::<f64>::zeros(2 * n, 12);
     for (k, (x, u)) in world.iter().zip(image).enumerate() {
         let xw = (x.coords - c3) * s3;
@@ -87,11 +71,11 @@ pub fn calibrate_dlt(world: &[Pt3], image: &[Pt2], width: u32, height: u32) -> R
     // square case too; A is 2n × 12 with 2n ≥ 12).
     let svd = a.svd(false, true);
     let vt = svd.v_t.ok_or_else(|| FitError::DegenerateCalibration("SVD did not converge".into()))?;
-    let (imin, _) = svd
-        .singular_values
-        .iter()
-        .enumerate()
-        .fold((0, f64::INFINITY), |(bi, bv), (i, &v)| if v < bv { (i, v) } else { (bi, bv) });
+    let (imin, _) =
+        svd.singular_values
+            .iter()
+            .enumerate()
+            .fold((0, f64::INFINITY), |(bi, bv), (i, &v)| if v < bv { (i, v) } else { (bi, bv) });
     let h = vt.row(imin);
     let pn = Mat34::from_row_slice(&h.iter().copied().collect::<Vec<f64>>());
     let t2i = t2.try_inverse().expect("a scaling with s > 0 is invertible");
@@ -142,16 +126,14 @@ mod tests {
         assert!(rms < 1e-8, "rms {rms}");
         assert!((est.p - c.p).norm() <= 1e-8 * c.p.norm(), "{} vs {}", est.p, c.p);
         // 0.5 px noise.
-        let noisy: Vec<Pt2> = image.iter().map(|p| p + nalgebra::Vector2::new(rng.normal(), rng.normal()) * 0.5).collect();
+        let noisy: Vec<Pt2> =
+            image.iter().map(|p| p + nalgebra::Vector2::new(rng.normal(), rng.normal()) * 0.5).collect();
         let (_, rms) = calibrate_dlt(&world, &noisy, 320, 240).unwrap();
         assert!(rms <= 1.5 * 0.5, "rms {rms}");
         // Coplanar and too few markers.
         let flat: Vec<Pt3> = (0..6).map(|i| Pt3::new(0.1 * i as f64, 0.05 * (i * i) as f64, 0.0)).collect();
         let fi: Vec<Pt2> = flat.iter().map(|x| c.project(x).unwrap().0).collect();
         assert!(matches!(calibrate_dlt(&flat, &fi, 320, 240), Err(FitError::DegenerateCalibration(_))));
-        assert!(matches!(
-            calibrate_dlt(&world[..5], &image[..5], 320, 240),
-            Err(FitError::DegenerateCalibration(_))
-        ));
+        assert!(matches!(calibrate_dlt(&world[..5], &image[..5], 320, 240), Err(FitError::DegenerateCalibration(_))));
     }
 }

@@ -53,10 +53,7 @@ pub fn frame_path(pattern: &str, k: usize) -> Result<PathBuf> {
 /// corrupt, truncated) and catch frames whose size differs from the first.
 pub fn load_png_sequence(pattern: &str, first: usize, count: usize) -> Result<Vec<ImageF32>> {
     let paths: Vec<PathBuf> = (first..first + count).map(|k| frame_path(pattern, k)).collect::<Result<_>>()?;
-    let frames: Vec<ImageF32> = paths
-        .par_iter()
-        .map(|p| read_png(p).map_err(|e| io(p, e)))
-        .collect::<Result<_>>()?;
+    let frames: Vec<ImageF32> = paths.par_iter().map(|p| read_png(p).map_err(|e| io(p, e))).collect::<Result<_>>()?;
     if let Some(f0) = frames.first() {
         for (f, p) in frames.iter().zip(&paths) {
             if (f.width, f.height) != (f0.width, f0.height) {
@@ -234,7 +231,11 @@ pub fn silhouettes(frames: &[ImageF32], s: &SilhouetteSource) -> Result<Vec<Mask
         }
         SilhouetteSource::Threshold { level } => frames
             .iter()
-            .map(|f| Mask { width: f.width, height: f.height, data: f.data.iter().map(|&v| v as f64 > *level).collect() })
+            .map(|f| Mask {
+                width: f.width,
+                height: f.height,
+                data: f.data.iter().map(|&v| v as f64 > *level).collect(),
+            })
             .collect(),
         SilhouetteSource::Masks { pattern, first } => {
             let m = load_png_sequence(pattern, *first, frames.len())?;

@@ -15,8 +15,8 @@ use geom_core::math::{smoothstep, Pt3, Vec3};
 use geom_core::procedural::{grid, Diagonals, GridSpec, Plane};
 use serde::{Deserialize, Serialize};
 use shells::{
-    Damping, Effects, IntegratorKind, IntegratorSettings, Material, MembraneLaw, ShellSceneDesc, ShellSim,
-    ShellState, VertexConstraint, WarpSource,
+    Damping, Effects, IntegratorKind, IntegratorSettings, Material, MembraneLaw, ShellSceneDesc, ShellSim, ShellState,
+    VertexConstraint, WarpSource,
 };
 
 use crate::drag::DragForce;
@@ -104,8 +104,13 @@ pub struct SimTrajectory {
 /// evaluations run in parallel.
 pub trait ForwardModel: Sync {
     /// Simulates experiment `e` with parameters `p`; positions at the frame times.
-    fn simulate(&self, p: &FabricParams, e: &Experiment, rig: &Rig, opts: &SimOptions)
-        -> Result<SimTrajectory, SimError>;
+    fn simulate(
+        &self,
+        p: &FabricParams,
+        e: &Experiment,
+        rig: &Rig,
+        opts: &SimOptions,
+    ) -> Result<SimTrajectory, SimError>;
     /// Triangles of the rendered mesh.
     fn faces(&self, opts: &SimOptions) -> Vec<[u32; 3]>;
 }
@@ -124,8 +129,13 @@ pub struct SwatchMesh {
 
 /// The `res × res` grid over `w × h` with alternating diagonals (geom-core's grid generator).
 pub fn swatch_mesh(res: usize, w: f64, h: f64) -> SwatchMesh {
-    let spec =
-        GridSpec { quads: [res as u32; 2], size: [w, h], plane: Plane::XZ, diagonals: Diagonals::Alternating, ..Default::default() };
+    let spec = GridSpec {
+        quads: [res as u32; 2],
+        size: [w, h],
+        plane: Plane::XZ,
+        diagonals: Diagonals::Alternating,
+        ..Default::default()
+    };
     let m = grid(&spec).expect("validated: res ≥ 1 and a positive finite size make a valid grid");
     let uv = m.positions.iter().map(|p| (p.x + 0.5 * w, p.z + 0.5 * h)).collect();
     let n = res as u32 + 1;
@@ -178,11 +188,8 @@ impl RenderRefine {
                     nbr[f[(k + 1) % 3] as usize].insert(f[k]);
                 }
             }
-            let interior_mid: Vec<u32> = edges
-                .iter()
-                .filter(|(e, _)| boundary.get(e).copied().unwrap_or(0) == 2)
-                .map(|(_, &m)| m)
-                .collect();
+            let interior_mid: Vec<u32> =
+                edges.iter().filter(|(e, _)| boundary.get(e).copied().unwrap_or(0) == 2).map(|(_, &m)| m).collect();
             let old = stencils.clone();
             for m in interior_mid {
                 let ns: Vec<u32> = nbr[m as usize].iter().copied().collect();
@@ -274,11 +281,7 @@ impl FrameSampler {
                 break;
             }
             let s = if (t1 - tf).abs() <= 1e-9 * (t1 - t0) { 1.0 } else { ((tf - t0) / (t1 - t0)).clamp(0.0, 1.0) };
-            let q = if s == 1.0 {
-                q1.to_vec()
-            } else {
-                q0.iter().zip(q1).map(|(a, b)| a + s * (b - a)).collect()
-            };
+            let q = if s == 1.0 { q1.to_vec() } else { q0.iter().zip(q1).map(|(a, b)| a + s * (b - a)).collect() };
             self.frames.push(q);
             self.times.push(tf);
         }
@@ -314,9 +317,7 @@ impl ShellsForward {
             .uv
             .iter()
             .zip(&rest)
-            .map(|(&(u, v), x)| {
-                x + e.settle.bulge_m * (pi * u / sw.width).sin() * (pi * v / sw.height).sin() * toward
-            })
+            .map(|(&(u, v), x)| x + e.settle.bulge_m * (pi * u / sw.width).sin() * (pi * v / sw.height).sin() * toward)
             .collect();
         let faces = Arc::new(mesh.faces.clone());
         let mut drag = DragForce::new(p.drag, faces.clone());

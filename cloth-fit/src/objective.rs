@@ -161,9 +161,20 @@ impl<'a> Objective<'a> {
                     });
                 }
             }
-            bound += t.frames.len() as f64 * (w as f64 * h as f64) * (std::f64::consts::FRAC_PI_2.powi(2) + setup.metric.alpha);
+            bound += t.frames.len() as f64
+                * (w as f64 * h as f64)
+                * (std::f64::consts::FRAC_PI_2.powi(2) + setup.metric.alpha);
         }
-        Ok(Self { targets, forward, space, setup, faces: forward.faces(&setup.model), bound, state: Mutex::new(State::default()), created: Instant::now() })
+        Ok(Self {
+            targets,
+            forward,
+            space,
+            setup,
+            faces: forward.faces(&setup.model),
+            bound,
+            state: Mutex::new(State::default()),
+            created: Instant::now(),
+        })
     }
 
     /// The search space.

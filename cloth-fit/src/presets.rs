@@ -29,7 +29,8 @@ pub enum FabricPreset {
 
 impl FabricPreset {
     /// All four, in the paper's order.
-    pub const ALL: [FabricPreset; 4] = [FabricPreset::Linen, FabricPreset::Fleece, FabricPreset::Satin, FabricPreset::Knit];
+    pub const ALL: [FabricPreset; 4] =
+        [FabricPreset::Linen, FabricPreset::Fleece, FabricPreset::Satin, FabricPreset::Knit];
 
     /// Lower-case name (summary-key suffix).
     pub fn name(self) -> &'static str {
@@ -101,7 +102,12 @@ pub fn drag_midpoint() -> DragParams {
 /// Static trial `k` (0 or 1: separations 0.40 m and 0.30 m) with `frames` frames.
 pub fn static_trial(f: FabricPreset, k: usize, frames: usize) -> Experiment {
     let separation = if k == 0 { 0.40 } else { 0.30 };
-    Experiment { kind: ExperimentKind::Static { separation }, swatch: f.swatch(), frames, settle: SettleProtocol::default() }
+    Experiment {
+        kind: ExperimentKind::Static { separation },
+        swatch: f.swatch(),
+        frames,
+        settle: SettleProtocol::default(),
+    }
 }
 
 /// Waving trial `k` (spec §4.7): trial 0 at 0.40 m, amplitude (0.08, 0.12, 0) m at 1 Hz; trial 1

@@ -228,7 +228,13 @@ pub fn render_frame(p: &[Pt3], faces: &[[u32; 3]], rig: &Rig, o: &RenderOptions)
 
 /// [`render_frame`] seen by another camera (the perturbed camera of the noise model); the
 /// projector and shading are the rig's.
-pub fn render_frame_with_camera(p: &[Pt3], faces: &[[u32; 3]], rig: &Rig, cam: &Camera, o: &RenderOptions) -> RenderOutput {
+pub fn render_frame_with_camera(
+    p: &[Pt3],
+    faces: &[[u32; 3]],
+    rig: &Rig,
+    cam: &Camera,
+    o: &RenderOptions,
+) -> RenderOutput {
     let ro = RasterOptions { supersample: o.supersample.max(1), ..RasterOptions::default() };
     let gb = rasterize(cam, p, faces, &ro);
     let mut r2 = rig.clone();

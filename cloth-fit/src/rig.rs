@@ -307,8 +307,8 @@ impl RigSpec {
 /// Reads a calibration file (RON [`RigSpec`]) and builds the rig (spec §3.4 `load_rig`).
 /// Errors name the file (and the line and column for syntax errors).
 pub fn load_rig(path: &Path) -> Result<BuiltRig> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| FitError::Io { path: path.to_path_buf(), msg: e.to_string() })?;
+    let text =
+        std::fs::read_to_string(path).map_err(|e| FitError::Io { path: path.to_path_buf(), msg: e.to_string() })?;
     let spec: RigSpec = ron::Options::default()
         .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
         .from_str(&text)

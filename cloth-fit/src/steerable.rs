@@ -112,7 +112,9 @@ pub fn h2_steer(theta: f64) -> [f64; 4] {
 pub fn oriented_energy(g: [f64; 3], h: [f64; 4]) -> (f64, f64) {
     let [ga, gb, gc] = g;
     let [ha, hb, hc, hd] = h;
-    let c2 = 0.5 * (ga * ga - gc * gc) + 0.46875 * (ha * ha - hd * hd) + 0.28125 * (hb * hb - hc * hc)
+    let c2 = 0.5 * (ga * ga - gc * gc)
+        + 0.46875 * (ha * ha - hd * hd)
+        + 0.28125 * (hb * hb - hc * hc)
         + 0.1875 * (ha * hc - hb * hd);
     let c3 = -ga * gb - gb * gc - 0.9375 * (hc * hd + ha * hb) - 1.6875 * hb * hc - 0.1875 * ha * hd;
     (c2, c3)
@@ -144,11 +146,7 @@ mod tests {
                     let g_rot = G2_NORM * g2(xr) * g0(yr);
                     let h_rot = H2_NORM * h3(xr) * g0(yr);
                     let (ii, jj) = ((i + r) as usize, (j + r) as usize);
-                    let g_basis = [
-                        G2_NORM * g2(x) * g0(y),
-                        2.0 * G2_NORM * g1(x) * g1(y),
-                        G2_NORM * g0(x) * g2(y),
-                    ];
+                    let g_basis = [G2_NORM * g2(x) * g0(y), 2.0 * G2_NORM * g1(x) * g1(y), G2_NORM * g0(x) * g2(y)];
                     let g_st: f64 = gs.iter().zip(&g_basis).map(|(a, b)| a * b).sum();
                     let h_st: f64 = hs.iter().zip(&k[3..7]).map(|(a, kk)| a * kk[jj][ii]).sum();
                     assert!((g_rot - g_st).abs() < 1e-10, "G2 at θ = {th}: {g_rot} vs {g_st}");

@@ -3,6 +3,7 @@
 //! experiment into one report.
 
 mod bench_barnet;
+mod bench_cloth_fit;
 mod bench_curve_skin;
 mod bench_flip_tet;
 mod bench_geom_core;
@@ -12,6 +13,7 @@ mod bench_rigging;
 mod bench_shells;
 mod bench_tracks;
 mod bench_wrinkles;
+mod crates;
 mod error;
 mod inspect;
 mod out;

@@ -37,6 +37,9 @@ pub struct FileRecorder {
     pub scene: Vec<SceneItem>,
     /// Mesh frames written per sequence (count).
     pub frames_written: BTreeMap<String, usize>,
+    /// Progress bar of the run's main loop (created by the first `progress` call; hidden when
+    /// stderr is not a terminal).
+    bar: Option<indicatif::ProgressBar>,
 }
 
 fn core_io(path: &Path) -> impl FnOnce(std::io::Error) -> geom_core::Error + '_ {
@@ -64,6 +67,7 @@ impl FileRecorder {
             notes: None,
             scene: Vec::new(),
             frames_written: BTreeMap::new(),
+            bar: None,
         })
     }
 
@@ -74,6 +78,9 @@ impl FileRecorder {
 
     /// Draws the plots (one PNG per plot name). Call once when the experiment returns.
     pub fn finish(&mut self) -> Result<()> {
+        if let Some(b) = self.bar.take() {
+            b.finish_and_clear();
+        }
         for (name, p) in &self.plots {
             p.write_png(&self.dir.join(format!("{name}.png")))?;
         }
@@ -143,6 +150,19 @@ impl Recorder for FileRecorder {
         }
         let f = self.notes.as_mut().expect("opened just above");
         writeln!(f, "{text}").map_err(core_io(&path))
+    }
+
+    fn progress(&mut self, done: u64, total: u64) {
+        let bar = self.bar.get_or_insert_with(|| {
+            let b = indicatif::ProgressBar::new(total);
+            b.set_style(
+                indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} (eta {eta})")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            b
+        });
+        bar.set_length(total);
+        bar.set_position(done.min(total));
     }
 
     fn file(&mut self, name: &str, bytes: &[u8]) -> geom_core::Result<()> {
