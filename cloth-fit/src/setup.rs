@@ -76,7 +76,7 @@ pub struct SettleProtocol {
 }
 
 impl Default for SettleProtocol {
-    /// 2 mm bulge, 0.5 s corner move, 2.5 s settle (max 4 s), α = 5 s⁻¹, 1e-8 m²/s², then 10
+    /// 2 mm bulge, 0.5 s corner move, 2.5 s settle (max 4 s), α = 5 s⁻¹, 1e-8 m²/s², then 40
     /// relaxation steps of 1 s.
     fn default() -> Self {
         Self {
@@ -86,7 +86,7 @@ impl Default for SettleProtocol {
             max_s: 4.0,
             alpha: 5.0,
             ke_per_mass: 1e-8,
-            relax_steps: 10,
+            relax_steps: 40,
             relax_dt: 1.0,
         }
     }

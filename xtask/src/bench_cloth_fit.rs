@@ -53,7 +53,7 @@ fn base(quick: bool) -> Params {
             coarse_values: BySize::Same(2),
             anneal_evals: BySize::Same(if quick { 20 } else { 60 }),
             variability_samples: BySize::Same(5),
-            anneal: Default::default(),
+            anneal: BySize::Same(Default::default()),
         },
         knobs: BySize::Same(Vec::new()),
         dt_bias: BySize::Same(Vec::new()),

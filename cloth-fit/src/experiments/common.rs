@@ -41,7 +41,8 @@ pub struct FitScale {
     /// Renderer (fit side).
     #[serde(default)]
     pub render: RenderOptions,
-    /// Angle maps.
+    /// Angle maps. `grad_threshold` is given for a 320-pixel-wide image and scaled by
+    /// 320/width: a fold's change of angle per pixel grows as the pixels get larger.
     #[serde(default)]
     pub angle: AngleOptions,
     /// Frame error.
@@ -67,9 +68,10 @@ impl FitScale {
             implicit_drag: false,
         };
         model.validate()?;
-        self.angle.validate()?;
+        let angle = AngleOptions { grad_threshold: self.angle.grad_threshold * 320.0 / w as f64, ..self.angle };
+        angle.validate()?;
         self.noise.validate()?;
-        Ok(EvalSetup { rig, model, render: self.render, angle: self.angle, metric: self.metric })
+        Ok(EvalSetup { rig, model, render: self.render, angle, metric: self.metric })
     }
 }
 
@@ -83,9 +85,13 @@ pub struct SearchScale {
     pub anneal_evals: BySize<usize>,
     /// Variability samples per parameter (spec: 9).
     pub variability_samples: BySize<usize>,
-    /// Other annealing settings (budget replaced by `anneal_evals`).
-    #[serde(default)]
-    pub anneal: AnnealOptions,
+    /// Other annealing settings per run size (budget replaced by `anneal_evals`).
+    #[serde(default = "default_anneal")]
+    pub anneal: BySize<AnnealOptions>,
+}
+
+fn default_anneal() -> BySize<AnnealOptions> {
+    BySize::Same(AnnealOptions::default())
 }
 
 impl SearchScale {
@@ -97,7 +103,7 @@ impl SearchScale {
                 params: ParamId::STIFFNESS.to_vec(),
             },
             dynamic_init,
-            anneal: AnnealOptions { max_evals: self.anneal_evals.get(size), ..self.anneal },
+            anneal: AnnealOptions { max_evals: self.anneal_evals.get(size), ..self.anneal.get(size) },
             trials,
             variability: variability
                 .then(|| VariabilityOptions { samples: self.variability_samples.get(size), ..Default::default() }),

@@ -257,7 +257,10 @@ pub fn dt_bias(p: &Params, size: Size, dts: &[f64], progress: &mut dyn FnMut(u64
             let opts = FitOptions {
                 coarse: CoarseSearch::Grid { values_per_param: 3, params: damp.to_vec() },
                 dynamic_init: DynamicInit::Fixed(0.5),
-                anneal: crate::anneal::AnnealOptions { max_evals: p.dt_bias_evals.get(size), ..p.search.anneal },
+                anneal: crate::anneal::AnnealOptions {
+                    max_evals: p.dt_bias_evals.get(size),
+                    ..p.search.anneal.get(size)
+                },
                 trials: TrialPolicy::PerTrialThenSelect,
                 variability: None,
             };

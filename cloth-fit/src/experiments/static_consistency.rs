@@ -78,7 +78,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let recs = coarse_search(&obj, &coarse, &vec![0.375; sp.dim()])?;
     let base = best_record(&recs).expect("coarse_search guarantees a success").params;
     let errs: Vec<f64> = recs.iter().filter(|r| r.status == EvalStatus::Ok).map(|r| r.error).collect();
-    let t0 = initial_temperature(&errs, &[], p.search.anneal.t0_factor);
+    let t0 = initial_temperature(&errs, &[], p.search.anneal.get(size).t0_factor);
     let runs = p.runs.get(size).max(2);
     rec.note(&format!(
         "# C2 static consistency\n\n{}, {runs} runs from starts within ±{:.0} % of the best coarse point, {}",
@@ -99,7 +99,11 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
             start_p.set(id, base.get(id) * (1.0 + p.start_spread * (2.0 * rng.f64() - 1.0)));
         }
         let x0 = sp.to_unit(&start_p);
-        let o = AnnealOptions { max_evals: p.search.anneal_evals.get(size), seed: 100 + k as u64, ..p.search.anneal };
+        let o = AnnealOptions {
+            max_evals: p.search.anneal_evals.get(size),
+            seed: 100 + k as u64,
+            ..p.search.anneal.get(size)
+        };
         let run_obj = Objective::new(&targets, &fwd, &sp, &setup)?;
         let y0 = run_obj.eval(&x0).error;
         let mut fb = |xs: &[Vec<f64>]| -> Vec<f64> {

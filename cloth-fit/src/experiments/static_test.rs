@@ -21,22 +21,24 @@
 use std::time::Instant;
 
 use geom_core::experiment::{BySize, Report, Size, Target};
+use geom_core::image::ImageF32;
 use geom_core::record::{Cell, Recorder};
 use geom_core::stats::{max, median, min};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::common::{
     fit_images, history_rows, history_table, per_fabric, picks, space, strip, truths, FitScale, SearchScale,
 };
 use crate::error::Result;
-use crate::fit::{fit, DynamicInit, TrialPolicy};
+use crate::fit::{fit, DynamicInit, FitReport, TrialPolicy};
 use crate::forward::ShellsForward;
 use crate::metrics::{all_err, error_of, param_errors, stiff_err, variability_of};
 use crate::objective::{EvalSetup, Objective};
 use crate::params::{FabricParams, ParamId};
 use crate::presets::{drag_midpoint, fit_model, static_trial, FabricPreset};
-use crate::synthetic::Condition;
-use crate::variability::{variability, VariabilityOptions};
+use crate::synthetic::{Condition, TruthSequence};
+use crate::variability::{variability, ParamVariability, VariabilityOptions};
 
 /// Scene parameters (the RON `params` block).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -86,10 +88,57 @@ pub fn time_full_static_eval(f: FabricPreset) -> Result<f64> {
     Ok(t0.elapsed().as_secs_f64())
 }
 
-/// Runs C1.
+/// One fabric's fit in one condition, everything the recording needs.
+struct FabricFit {
+    f: FabricPreset,
+    cond: Condition,
+    tr: Vec<TruthSequence>,
+    fr: FitReport,
+    errs: Vec<(ParamId, f64)>,
+    var: Vec<ParamVariability>,
+    e_star: f64,
+    wall: f64,
+    fit_img: Vec<ImageF32>,
+}
+
+fn fit_fabric(p: &Params, size: Size, setup: &EvalSetup, f: FabricPreset, cond: Condition) -> Result<FabricFit> {
+    let fwd = ShellsForward;
+    let t0 = Instant::now();
+    let n_trials = p.trials.get(size).clamp(1, 2);
+    let frames = p.frames.get(size).max(1);
+    let free = p.anneal_free.get(size);
+    let truth = static_truth(f);
+    let exps: Vec<_> = (0..n_trials).map(|k| static_trial(f, k, frames)).collect();
+    // Non-free cloth parameters sit at the grid's cell centre 3/8, not at the truth.
+    let six = space(&ParamId::CLOTH, truth)?;
+    let mut fixed = truth;
+    for id in ParamId::CLOTH {
+        if !free.contains(&id) {
+            fixed.set(id, six.range(id).from_unit(0.375));
+        }
+    }
+    let fit_space = space(&free, fixed)?;
+    let search = p.search.options(size, DynamicInit::Fixed(0.375), TrialPolicy::PerTrialThenSelect, false);
+    let tr = truths(&fwd, &exps, truth, setup, cond, p.fit.noise)?;
+    let targets: Vec<_> = tr.iter().map(|t| t.target.clone()).collect();
+    let fr = fit(&targets, &fwd, &fit_space, setup, &search, &mut |_, _| {})?;
+    let wall = t0.elapsed().as_secs_f64();
+    let errs = param_errors(&six, &fr.params, &truth);
+    // Variability at the truth on the same footage, all six cloth parameters.
+    let obj6 = Objective::new(&targets, &fwd, &six, setup)?;
+    let coarse: Vec<f64> = fr.coarse.iter().map(|r| r.error).collect();
+    let floor = 1e-3 * median(&coarse);
+    let vo = VariabilityOptions { samples: p.search.variability_samples.get(size), ..Default::default() };
+    let var = variability(&obj6, &truth, &vo, floor)?;
+    let e_star = obj6.eval_params(&[truth])[0].error;
+    let fit_img = exps.iter().map(|e| fit_images(&fwd, &fr.params, e, setup)[0].clone()).collect();
+    Ok(FabricFit { f, cond, tr, fr, errs, var, e_star, wall, fit_img })
+}
+
+/// Runs C1. Fabrics (and conditions) are fitted in parallel, as many at a time as there are
+/// rayon threads; each fit is independent, so the figures do not depend on the thread count.
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let setup = p.fit.setup(size)?;
-    let fwd = ShellsForward;
     let n_trials = p.trials.get(size).clamp(1, 2);
     let frames = p.frames.get(size).max(1);
     let conditions = p.conditions.get(size);
@@ -115,87 +164,65 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     rec.table("variability", &vhead)?;
     let (mut e_star, mut stiff_m, mut stiff_mm, mut bend_var, mut damp_var, mut failures) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new(), 0usize);
-    let search = p.search.options(size, DynamicInit::Fixed(0.375), TrialPolicy::PerTrialThenSelect, false);
-    for &f in &p.fabrics {
-        let truth = static_truth(f);
-        let exps: Vec<_> = (0..n_trials).map(|k| static_trial(f, k, frames)).collect();
-        // Non-free cloth parameters sit at the grid's cell centre 3/8, not at the truth.
-        let six = space(&ParamId::CLOTH, truth)?;
-        let mut fixed = truth;
-        for id in ParamId::CLOTH {
-            if !free.contains(&id) {
-                fixed.set(id, six.range(id).from_unit(0.375));
-            }
-        }
-        let fit_space = space(&free, fixed)?;
-        for &cond in &conditions {
-            let t0 = Instant::now();
-            let tr = truths(&fwd, &exps, truth, &setup, cond, p.fit.noise)?;
-            let targets: Vec<_> = tr.iter().map(|t| t.target.clone()).collect();
-            let fr = fit(&targets, &fwd, &fit_space, &setup, &search, &mut |d, t| rec.progress(d, t))?;
-            let wall = t0.elapsed().as_secs_f64();
-            failures += fr.failures;
-            for (k, t) in fr.trials.iter().enumerate() {
-                history_rows(rec, "history", &format!("{}-{}-trial{k}", f.name(), cond.name()), &t.history)?;
-                let mut row = vec![
-                    Cell::from(f.name()),
-                    Cell::from(cond.name()),
-                    Cell::from(k),
-                    Cell::from(t.errors.iter().sum::<f64>()),
-                ];
+    let jobs: Vec<(FabricPreset, Condition)> =
+        p.fabrics.iter().flat_map(|&f| conditions.iter().map(move |&c| (f, c))).collect();
+    let chunk = rayon::current_num_threads().max(1);
+    let mut done = 0;
+    for batch in jobs.chunks(chunk) {
+        let fits: Vec<FabricFit> =
+            batch.par_iter().map(|&(f, c)| fit_fabric(p, size, &setup, f, c)).collect::<Result<_>>()?;
+        done += batch.len();
+        rec.progress(done as u64, jobs.len() as u64);
+        for ff in fits {
+            let (f, cond) = (ff.f, ff.cond);
+            let c = cond.name();
+            failures += ff.fr.failures;
+            for (k, t) in ff.fr.trials.iter().enumerate() {
+                history_rows(rec, "history", &format!("{}-{c}-trial{k}", f.name()), &t.history)?;
+                let mut row =
+                    vec![Cell::from(f.name()), Cell::from(c), Cell::from(k), Cell::from(t.errors.iter().sum::<f64>())];
                 row.extend(ParamId::CLOTH.iter().map(|&id| Cell::from(t.params.get(id))));
                 row.extend([Cell::from(t.own_error), Cell::from(t.anneal.evals)]);
                 rec.row("static_table", &row)?;
             }
-            let errs = param_errors(&six, &fr.params, &truth);
-            let c = cond.name();
-            // Variability at the truth on the same footage, all six cloth parameters.
-            let obj6 = Objective::new(&targets, &fwd, &six, &setup)?;
-            let coarse: Vec<f64> = fr.coarse.iter().map(|r| r.error).collect();
-            let floor = 1e-3 * median(&coarse);
-            let vo = VariabilityOptions { samples: p.search.variability_samples.get(size), ..Default::default() };
-            let var = variability(&obj6, &truth, &vo, floor)?;
-            let se = stiff_err(&errs, &var);
+            let se = stiff_err(&ff.errs, &ff.var);
             per_fabric(&mut r, &format!("stiff_err_{c}"), f, se);
-            per_fabric(&mut r, &format!("bend_err_{c}"), f, error_of(&errs, ParamId::Bend));
-            per_fabric(&mut r, &format!("stretch_err_{c}"), f, error_of(&errs, ParamId::Stretch));
-            per_fabric(&mut r, &format!("shear_err_{c}"), f, error_of(&errs, ParamId::Shear));
-            per_fabric(&mut r, &format!("all_err_{c}"), f, all_err(&errs));
-            r.timing(&format!("fit_wall_s_{c}_{}", f.name()), wall);
-            r.count(&format!("simulations_{c}_{}", f.name()), fr.simulations as u64);
+            for id in ParamId::CLOTH {
+                per_fabric(&mut r, &format!("{}_err_{c}", id.name()), f, error_of(&ff.errs, id));
+            }
+            per_fabric(&mut r, &format!("all_err_{c}"), f, all_err(&ff.errs));
+            r.timing(&format!("fit_wall_s_{c}_{}", f.name()), ff.wall);
+            r.count(&format!("simulations_{c}_{}", f.name()), ff.fr.simulations as u64);
             if cond == Condition::Matched {
-                let es = obj6.eval_params(&[truth])[0].error;
-                per_fabric(&mut r, "e_star", f, es);
-                e_star.push(es);
+                per_fabric(&mut r, "e_star", f, ff.e_star);
+                e_star.push(ff.e_star);
                 stiff_m.push(se);
                 let mut row = vec![Cell::from(f.name())];
-                row.extend(ParamId::CLOTH.iter().map(|&id| Cell::from(variability_of(&var, id))));
+                row.extend(ParamId::CLOTH.iter().map(|&id| Cell::from(variability_of(&ff.var, id))));
                 rec.row("variability", &row)?;
                 for id in ParamId::CLOTH {
-                    per_fabric(&mut r, &format!("static_{}_variability", id.name()), f, variability_of(&var, id));
+                    per_fabric(&mut r, &format!("static_{}_variability", id.name()), f, variability_of(&ff.var, id));
                 }
                 let dv: Vec<f64> = [ParamId::StretchDamp, ParamId::ShearDamp, ParamId::BendDamp]
                     .iter()
-                    .map(|&id| variability_of(&var, id))
+                    .map(|&id| variability_of(&ff.var, id))
                     .collect();
                 per_fabric(&mut r, "static_damping_variability_min", f, min(&dv));
                 damp_var.extend(dv);
-                bend_var.push(variability_of(&var, ParamId::Bend));
+                bend_var.push(variability_of(&ff.var, ParamId::Bend));
             } else {
                 stiff_mm.push(se);
             }
             // Truth versus fit, frame 0 of every trial.
-            let fit_img: Vec<_> =
-                exps.iter().map(|e| fit_images(&fwd, &fr.params, &e.clone(), &setup)[0].clone()).collect();
-            let truth_img: Vec<_> = tr.iter().map(|t| t.images[0].clone()).collect();
-            rec.file(&format!("{}/{c}/strip.png", f.name()), &strip(&truth_img, &fit_img, &picks(exps.len(), 2)))?;
+            let truth_img: Vec<_> = ff.tr.iter().map(|t| t.images[0].clone()).collect();
+            rec.file(&format!("{}/{c}/strip.png", f.name()), &strip(&truth_img, &ff.fit_img, &picks(ff.tr.len(), 2)))?;
             rec.note(&format!(
                 "- {} ({c}): bend error {:.4}, stiff_err {:.4}, {} simulations in {:.1} s",
                 f.name(),
-                error_of(&errs, ParamId::Bend),
+                error_of(&ff.errs, ParamId::Bend),
                 se,
-                fr.simulations,
-                wall
+                ff.fr.simulations,
+                ff.wall
             ))?;
         }
     }

@@ -18,7 +18,7 @@ use geom_core::experiment::{Report, Size, Target};
 use geom_core::record::Recorder;
 use geom_core::stats::max;
 
-use super::waving::{run_fabric, tables};
+use super::waving::{run_all, tables};
 use crate::error::{FitError, Result};
 
 /// Scene parameters: the waving protocol's, with `validation_frames` > 0.
@@ -32,9 +32,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     rec.note(&format!("# C6 validation on the held-out robot sinusoid ({} frames)\n", p.validation_frames.get(size)))?;
     tables(rec)?;
     let mut r = Report::default();
-    for &f in &p.fabrics {
-        run_fabric(p, size, f, rec, &mut r, true)?;
-    }
+    run_all(p, size, rec, &mut r)?;
     let v: Vec<f64> = p.fabrics.iter().map(|f| r.get_f64(&format!("val_ratio_{}", f.name()))).collect();
     r.num("val_ratio_max", max(&v));
     if size == Size::Full {

@@ -16,7 +16,7 @@
 use geom_core::experiment::{Report, Size, Target};
 use geom_core::record::Recorder;
 
-use super::waving::{run_fabric, tables};
+use super::waving::{fit_fabric, record, tables};
 use crate::error::{FitError, Result};
 
 /// Scene parameters: those of the waving scene, with exactly one fabric.
@@ -33,7 +33,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     rec.note(&format!("# Waving protocol, {} only\n", f.name()))?;
     tables(rec)?;
     let mut r = Report::default();
-    run_fabric(p, size, f, rec, &mut r, false)?;
+    let w = fit_fabric(p, size, f, &mut |d, t| rec.progress(d, t))?;
+    record(p, size, &w, rec, &mut r, false)?;
     let c = p.condition.get(size).name();
     if size == Size::Full {
         r.check("fit_wall_s", Target::AtMost(1500.0), "issue 24: one full waving fit ≤ 1 500 s (paper ≈ 50 h)");
