@@ -99,7 +99,10 @@ fn t17_t18_penalty_determinism_and_the_search_continues() {
     assert!(matches!(bad.status, EvalStatus::SimFailed(_)));
     assert!(bad.error.is_finite() && bad.error == 2.0 * a.error, "{} vs {}", bad.error, a.error);
     assert_eq!(obj.failures(), 1);
-    // The search continues through failures: a fit whose grid straddles the failure threshold.
+    // The search continues through failures: a fit whose grid straddles the failure threshold
+    // (the 3-value stretch grid sits at the cell centres 28, 224 and 1774 N/m; this stub fails
+    // above 1000 N/m, so the top row fails).
+    let stub = Stub { fail_above: 1000.0, calls: AtomicUsize::new(0) };
     let opts = FitOptions {
         coarse: CoarseSearch::Grid { values_per_param: 3, params: vec![ParamId::Stretch, ParamId::Bend] },
         dynamic_init: DynamicInit::Fixed(0.5),
