@@ -320,6 +320,18 @@ impl ShellsForward {
             .map(|(&(u, v), x)| x + e.settle.bulge_m * (pi * u / sw.width).sin() * (pi * v / sw.height).sin() * toward)
             .collect();
         let faces = Arc::new(mesh.faces.clone());
+        // The settle runs with a fixed damping and drag (see `SettleProtocol::damping`); the
+        // fabric's own values take over for the recorded motion.
+        let settle_p = FabricParams {
+            stretch_damp: e.settle.damping,
+            shear_damp: e.settle.damping,
+            bend_damp: e.settle.damping,
+            drag: crate::presets::drag_midpoint(),
+            ..*p
+        };
+        let mut settle_drag = DragForce::new(settle_p.drag, faces.clone());
+        settle_drag.implicit = opts.implicit_drag;
+        let settle_drag = Arc::new(settle_drag);
         let mut drag = DragForce::new(p.drag, faces.clone());
         drag.implicit = opts.implicit_drag;
         let drag = Arc::new(drag);
@@ -329,6 +341,7 @@ impl ShellsForward {
         };
         let integrator = IntegratorSettings { kind, ..Default::default() };
         let effects = Effects { gravity: Some(rig.gravity()), custom: vec![drag], ..Default::default() };
+        let settle_effects = Effects { custom: vec![settle_drag], ..effects.clone() };
         let [c0, c1] = mesh.corners;
         let starts = [rest[c0 as usize], rest[c1 as usize]];
         let targets = e.corner_targets();
@@ -344,8 +357,8 @@ impl ShellsForward {
             uv: None,
             initial: Some(initial),
             initial_velocity: None,
-            material: material(p, sw.areal_density, e.settle.alpha),
-            effects: effects.clone(),
+            material: material(&settle_p, sw.areal_density, e.settle.alpha),
+            effects: settle_effects,
             constraints: vec![VertexConstraint::Kinematic(vec![c0, c1], Box::new(settle_path))],
             integrator: integrator.clone(),
             t0: 0.0,
