@@ -25,7 +25,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         short.settle.settle_s = 1.0;
         short.settle.ke_per_mass = std::env::var("KE").ok().and_then(|s| s.parse().ok()).unwrap_or(1e-4);
         let s1 = ShellsForward.simulate_raw(&p, &short, &rig, &model)?;
-        let d = base.frames[0].iter().zip(&s1.frames[0]).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+        let d = base.frames[0].iter().zip(&s1.frames[0]).map(|(a, b)| (a - b).norm()).collect::<Vec<_>>();
+        let d = geom_core::stats::max(&d);
         println!(
             "{:6} settle 1.0 s instead of 2.5 s: max |Δx| = {d:.3e} m (steps {} vs {})",
             f.name(),
@@ -35,7 +36,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for id in [ParamId::StretchDamp, ParamId::ShearDamp, ParamId::BendDamp, ParamId::DragN] {
             let q = p.with(id, p.get(id) * 1.05);
             let other = ShellsForward.simulate_raw(&q, &e, &rig, &model)?;
-            let d = base.frames[0].iter().zip(&other.frames[0]).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max);
+            let d: Vec<f64> = base.frames[0].iter().zip(&other.frames[0]).map(|(a, b)| (a - b).norm()).collect();
+            let d = geom_core::stats::max(&d);
             println!(
                 "{:6} {:12}: max |Δx| = {:.3e} m  (settle {:.3} s vs {:.3} s, settled {} / {})",
                 f.name(),

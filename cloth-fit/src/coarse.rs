@@ -15,8 +15,10 @@ use crate::params::ParamId;
 /// The coarse search (spec §2 `CoarseSearch`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub enum CoarseSearch {
-    /// No search: start from the base point.
-    None,
+    /// No search: start from the base point. (Not `None`: inside the untagged `BySize` of a
+    /// scene file, ron hands a bare `None` to serde as an empty option, and `Some(None)` no
+    /// longer parsed as this variant.)
+    Off,
     /// A full grid over `params` with `values_per_param` cell centres each; the other free
     /// parameters stay at the base point.
     Grid {
@@ -38,7 +40,7 @@ pub enum CoarseSearch {
 /// the parameters that are not gridded.
 pub fn coarse_points(c: &CoarseSearch, free: &[ParamId], base: &[f64]) -> Result<Vec<Vec<f64>>> {
     match c {
-        CoarseSearch::None => Ok(vec![base.to_vec()]),
+        CoarseSearch::Off => Ok(vec![base.to_vec()]),
         CoarseSearch::Grid { values_per_param: k, params } => {
             if !(1..=8).contains(k) {
                 return Err(FitError::BadParameter(format!("coarse grid: values_per_param {k} outside 1..=8")));

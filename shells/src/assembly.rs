@@ -71,8 +71,12 @@ pub(crate) struct Assembler {
     pub custom_diag: Vec<Mat3>,
     /// Custom off-diagonal blocks: (offset of the block in a triangle's local matrix, block).
     pub custom_offdiag: Vec<(usize, Mat3)>,
+    /// Contact Hessian blocks (h² times the barrier and friction Hessians) per free vertex.
+    pub contact_diag: Vec<Mat3>,
+    /// Contact off-diagonal blocks inside the pattern: (offset in a triangle's local matrix, block).
+    pub contact_offdiag: Vec<(usize, Mat3)>,
     /// Offset of block (i, j) in the local matrix of the first triangle holding both vertices.
-    block_offset: std::collections::HashMap<(u32, u32), usize>,
+    pub(crate) block_offset: std::collections::HashMap<(u32, u32), usize>,
 }
 
 impl Assembler {
@@ -202,6 +206,8 @@ impl Assembler {
             force_idx,
             custom_diag: vec![Mat3::zeros(); nf],
             custom_offdiag: Vec::new(),
+            contact_diag: vec![Mat3::zeros(); nf],
+            contact_offdiag: Vec::new(),
             block_offset,
             dofs,
         }
@@ -337,7 +343,7 @@ impl Assembler {
                 m.copy_from_slice(mat.as_slice());
             });
         // Custom off-diagonal Jacobian blocks, in the order given (deterministic).
-        for &(off, m) in &self.custom_offdiag {
+        for &(off, m) in self.custom_offdiag.iter().chain(&self.contact_offdiag) {
             for r in 0..3 {
                 for c in 0..3 {
                     tri_vals[off + c * 9 + r] += m[(r, c)];
@@ -346,11 +352,11 @@ impl Assembler {
         }
         // Diagonal mass blocks (1 + hα + τ)m I + custom Jacobian blocks.
         let dofs = &self.dofs;
-        let custom = &self.custom_diag;
+        let (custom, contact) = (&self.custom_diag, &self.contact_diag);
         diag_vals.par_chunks_mut(DIAG_VALS).enumerate().for_each(|(fidx, d)| {
             let v = dofs.free_vertices[fidx] as usize;
             let m = mesh.mass[v] * (1.0 + h * alpha + inp.shift);
-            let blk = Mat3::from_diagonal_element(m) + custom[fidx];
+            let blk = Mat3::from_diagonal_element(m) + custom[fidx] + contact[fidx];
             d.copy_from_slice(blk.as_slice());
         });
         // Per-vertex force sums in fixed element order.
@@ -375,7 +381,7 @@ impl Assembler {
         for fidx in 0..self.dofs.n_free() {
             let v = self.dofs.free_vertices[fidx] as usize;
             let m = mesh.mass[v] * (1.0 + h_eff * alpha + shift);
-            let blk = Mat3::from_diagonal_element(m) + self.custom_diag[fidx];
+            let blk = Mat3::from_diagonal_element(m) + self.custom_diag[fidx] + self.contact_diag[fidx];
             let o = self.off_diag + fidx * DIAG_VALS;
             self.vals[o..o + DIAG_VALS].copy_from_slice(blk.as_slice());
         }

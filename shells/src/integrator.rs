@@ -102,6 +102,8 @@ pub struct StepStats {
     pub newton_iters: u32,
     /// Line-search halvings.
     pub line_search_halvings: u32,
+    /// What the IPC contact model did (zero with the Bridson filter or without collisions).
+    pub contact: crate::contact::ContactStats,
 }
 
 /// Free / pinned / kinematic classification of the vertices and the free-DOF numbering.

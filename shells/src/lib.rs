@@ -18,18 +18,23 @@
 mod assembly;
 pub mod calib;
 pub mod collision;
+pub mod contact;
 pub mod effects;
 pub mod error;
+pub mod experiments;
 pub mod integrator;
 pub mod kernels;
 pub mod material;
 pub mod mesh;
+pub mod metrics;
 pub mod scene;
 pub mod sim;
 pub mod wind;
 
+pub use contact::ContactStats;
 pub use effects::{
-    BlockTriplets, CollisionSettings, Effects, ExternalForce, KinematicPath, Obstacle, ObstacleShape, Wind,
+    BlockTriplets, CollisionSettings, ContactMethod, Effects, ExternalForce, KinematicPath, Obstacle, ObstacleShape,
+    Wind,
 };
 pub use error::{Error, Result, ShellError};
 pub use integrator::{DofMap, ImplicitSystem, IntegratorKind, IntegratorSettings, StepStats, VelocitySolve};

@@ -31,9 +31,13 @@ pub struct ShellScene {
     /// Effects (each optional).
     #[serde(default)]
     pub effects: EffectsSpec,
-    /// Pinned vertex sets.
+    /// Pinned vertex sets (fixed at their rest positions).
     #[serde(default)]
     pub pins: Vec<PinSpec>,
+    /// Kinematic vertex sets: each set follows a rigid path from its rest placement (twist,
+    /// pull or carry the cloth); the sets must not overlap each other or `pins`.
+    #[serde(default)]
+    pub kinematic: Vec<KinematicPins>,
     /// Time stepping.
     #[serde(default)]
     pub integrator: SceneIntegrator,
@@ -65,6 +69,70 @@ pub enum MeshSpec {
         /// Path.
         path: String,
     },
+    /// An open cylinder along +y from the origin: `around` vertices per ring, `along` rings
+    /// (quads split into triangles); radius and length in metres.
+    Tube {
+        /// Radius (m).
+        radius: f64,
+        /// Length (m).
+        length: f64,
+        /// Vertices per ring (≥ 3).
+        around: u32,
+        /// Rings (≥ 2).
+        along: u32,
+    },
+}
+
+/// A vertex set that follows a rigid path.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KinematicPins {
+    /// The vertices.
+    pub set: PinSpec,
+    /// Their rigid motion from the placed rest positions.
+    pub path: geom_core::kinematic::KinematicPath,
+}
+
+/// Where a mesh obstacle's closed triangle mesh comes from.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub enum MeshSource {
+    /// An axis-aligned box (m), triangulated with `segments` quads per side.
+    Box {
+        /// Minimum corner (m).
+        min: Pt3,
+        /// Maximum corner (m).
+        max: Pt3,
+        /// Quads per side along x, y, z.
+        #[serde(default = "one3")]
+        segments: (u32, u32, u32),
+    },
+    /// A closed OBJ, PLY or OFF mesh (relative paths resolve against the base directory).
+    File {
+        /// Path.
+        path: String,
+    },
+}
+
+fn one3() -> (u32, u32, u32) {
+    (1, 1, 1)
+}
+
+/// A rigid obstacle given as a closed triangle mesh.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshObstacleSpec {
+    /// The mesh.
+    pub mesh: MeshSource,
+    /// Cloth–obstacle Coulomb friction μ.
+    #[serde(default = "half")]
+    pub friction: f64,
+    /// Rigid motion; `None` = static.
+    #[serde(default)]
+    pub motion: Option<geom_core::kinematic::KinematicPath>,
+}
+
+fn half() -> f64 {
+    0.5
 }
 
 /// Rigid placement: rotate (degrees about x, then y, then z, fixed axes), then translate (m).
@@ -110,6 +178,9 @@ pub struct EffectsSpec {
     /// Rigid obstacles.
     #[serde(default)]
     pub obstacles: Vec<Obstacle>,
+    /// Rigid obstacles given as closed triangle meshes (a box, a file).
+    #[serde(default)]
+    pub mesh_obstacles: Vec<MeshObstacleSpec>,
     /// Collision settings (`None`: no collision code at all).
     #[serde(default)]
     pub collision: Option<CollisionSettings>,
@@ -134,6 +205,16 @@ pub enum PinSpec {
         point: Pt3,
         /// Radius (m).
         radius: f64,
+    },
+    /// Every vertex within `tol` (m) of the plane through `point` with normal `normal` (placed
+    /// coordinates), e.g. one end ring of a tube.
+    Plane {
+        /// A point of the plane (m).
+        point: Pt3,
+        /// Its normal (normalised on use).
+        normal: Vec3,
+        /// Distance tolerance (m).
+        tol: f64,
     },
 }
 
@@ -251,6 +332,22 @@ impl ShellScene {
                 let p = base_dir.join(path);
                 (geom_core::io::obj::read_tri(&p)?, None)
             }
+            MeshSpec::Tube { radius, length, around, along } => {
+                if *along < 2 {
+                    return Err(Error::BadParameter(format!("mesh.Tube.along: a tube needs ≥ 2 rings, got {along}")));
+                }
+                let t = geom_core::procedural::tube(&geom_core::procedural::TubeSpec {
+                    radius: *radius,
+                    length: *length,
+                    around: *around,
+                    along: along - 1,
+                    start: Pt3::origin(),
+                    axis: Vec3::y(),
+                    caps: geom_core::procedural::Caps::Open,
+                })
+                .map_err(|e| Error::BadParameter(format!("mesh.Tube: {e}")))?;
+                (t.triangulate_fan()?.0, None)
+            }
         };
         let (rx, ry, rz) = self.placement.rotate_deg;
         let rot = UnitQuat::from_euler_angles(rx.to_radians(), ry.to_radians(), rz.to_radians());
@@ -266,43 +363,50 @@ impl ShellScene {
         let placed = mesh.with_positions(pos.clone())?;
         let n = pos.len() as u32;
         let mut pinned: Vec<u32> = Vec::new();
-        let need_grid = || Error::BadParameter("this pin set needs a Grid mesh".into());
-        for p in &self.pins {
-            match p {
-                PinSpec::Vertices(v) => pinned.extend(v),
-                PinSpec::TopCorners => {
-                    let (nx, ny) = dims.ok_or_else(need_grid)?;
-                    pinned.extend([(ny - 1) * nx, ny * nx - 1]);
-                }
-                PinSpec::Corners => {
-                    let (nx, ny) = dims.ok_or_else(need_grid)?;
-                    pinned.extend([0, nx - 1, (ny - 1) * nx, ny * nx - 1]);
-                }
-                PinSpec::LeftSide => {
-                    let (nx, ny) = dims.ok_or_else(need_grid)?;
-                    pinned.extend((0..ny).map(|j| j * nx));
-                }
-                PinSpec::LeftColumns(c) => {
-                    let (nx, ny) = dims.ok_or_else(need_grid)?;
-                    for j in 0..ny {
-                        pinned.extend((0..(*c).min(nx)).map(|i| j * nx + i));
-                    }
-                }
-                PinSpec::Near { point, radius } => {
-                    pinned.extend((0..n).filter(|&i| (pos[i as usize] - point).norm() <= *radius));
-                }
-            }
+        for (k, p) in self.pins.iter().enumerate() {
+            pinned.extend(select(p, dims, &pos).map_err(|m| Error::BadParameter(format!("pins[{k}]: {m}")))?);
         }
         pinned.sort_unstable();
         pinned.dedup();
         if let Some(&bad) = pinned.iter().find(|&&i| i >= n) {
-            return Err(Error::BadParameter(format!("pinned vertex {bad} out of range ({n} vertices)")));
+            return Err(Error::BadParameter(format!("pins: vertex {bad} out of range ({n} vertices)")));
+        }
+        let mut constraints =
+            if pinned.is_empty() { Vec::new() } else { vec![VertexConstraint::Pinned(pinned.clone())] };
+        let mut taken: std::collections::BTreeSet<u32> = pinned.iter().copied().collect();
+        for (k, kp) in self.kinematic.iter().enumerate() {
+            let field = format!("kinematic[{k}]");
+            kp.path.validate().map_err(|e| Error::BadParameter(format!("{field}.path: {e}")))?;
+            let mut ids = select(&kp.set, dims, &pos).map_err(|m| Error::BadParameter(format!("{field}.set: {m}")))?;
+            ids.sort_unstable();
+            ids.dedup();
+            if ids.is_empty() {
+                return Err(Error::BadParameter(format!("{field}.set selects no vertex")));
+            }
+            if let Some(&bad) = ids.iter().find(|&&i| i >= n) {
+                return Err(Error::BadParameter(format!("{field}.set: vertex {bad} out of range ({n} vertices)")));
+            }
+            if let Some(&dup) = ids.iter().find(|i| taken.contains(i)) {
+                return Err(Error::BadParameter(format!("{field}.set: vertex {dup} is already pinned or kinematic")));
+            }
+            taken.extend(&ids);
+            let rest: std::collections::HashMap<u32, Pt3> = ids.iter().map(|&i| (i, pos[i as usize])).collect();
+            let path = kp.path.clone();
+            let f: crate::sim::KinematicFn = Box::new(move |t, i| path.point_at(t, &rest[&i]));
+            constraints.push(VertexConstraint::Kinematic(ids, f));
         }
         let e = &self.effects;
+        let mut obstacles = e.obstacles.clone();
+        for (k, mo) in e.mesh_obstacles.iter().enumerate() {
+            obstacles.push(
+                mesh_obstacle(mo, base_dir)
+                    .map_err(|m| Error::BadParameter(format!("effects.mesh_obstacles[{k}]: {m}")))?,
+            );
+        }
         let effects = Effects {
             gravity: e.gravity,
             wind: e.wind.clone(),
-            obstacles: e.obstacles.clone(),
+            obstacles,
             self_collision: e.self_collision,
             collision: e.collision.clone(),
             custom: Vec::new(),
@@ -316,12 +420,83 @@ impl ShellScene {
             initial_velocity: (v0 != Vec3::zeros()).then(|| vec![v0; n as usize]),
             material: self.material.clone(),
             effects,
-            constraints: if pinned.is_empty() { Vec::new() } else { vec![VertexConstraint::Pinned(pinned)] },
+            constraints,
             integrator: self.integrator.settings(),
             t0: 0.0,
         };
         Ok(BuiltScene { desc, grid: dims, mesh: placed })
     }
+}
+
+/// The vertices of a pin set (`dims`: grid vertex counts for the grid-only sets).
+fn select(p: &PinSpec, dims: Option<(u32, u32)>, pos: &[Pt3]) -> std::result::Result<Vec<u32>, String> {
+    let n = pos.len() as u32;
+    let need_grid = || "this pin set needs a Grid mesh".to_string();
+    let mut out = Vec::new();
+    match p {
+        PinSpec::Vertices(v) => out.extend(v),
+        PinSpec::TopCorners => {
+            let (nx, ny) = dims.ok_or_else(need_grid)?;
+            out.extend([(ny - 1) * nx, ny * nx - 1]);
+        }
+        PinSpec::Corners => {
+            let (nx, ny) = dims.ok_or_else(need_grid)?;
+            out.extend([0, nx - 1, (ny - 1) * nx, ny * nx - 1]);
+        }
+        PinSpec::LeftSide => {
+            let (nx, ny) = dims.ok_or_else(need_grid)?;
+            out.extend((0..ny).map(|j| j * nx));
+        }
+        PinSpec::LeftColumns(c) => {
+            let (nx, ny) = dims.ok_or_else(need_grid)?;
+            for j in 0..ny {
+                out.extend((0..(*c).min(nx)).map(|i| j * nx + i));
+            }
+        }
+        PinSpec::Near { point, radius } => {
+            if !(radius.is_finite() && *radius >= 0.0) || point.iter().any(|c| !c.is_finite()) {
+                return Err(format!("Near needs a finite point and radius ≥ 0, got {radius}"));
+            }
+            out.extend((0..n).filter(|&i| (pos[i as usize] - point).norm() <= *radius));
+        }
+        PinSpec::Plane { point, normal, tol } => {
+            let nn = normal.try_normalize(0.0).ok_or("Plane needs a non-zero normal")?;
+            if !(tol.is_finite() && *tol >= 0.0) || point.iter().any(|c| !c.is_finite()) {
+                return Err(format!("Plane needs a finite point and tol ≥ 0, got {tol}"));
+            }
+            out.extend((0..n).filter(|&i| nn.dot(&(pos[i as usize] - point)).abs() <= *tol));
+        }
+    }
+    Ok(out)
+}
+
+/// A mesh obstacle as an [`Obstacle`]: the mesh must be closed (it has an inside).
+fn mesh_obstacle(mo: &MeshObstacleSpec, base_dir: &Path) -> std::result::Result<Obstacle, String> {
+    let m = match &mo.mesh {
+        MeshSource::Box { min, max, segments } => {
+            geom_core::procedural::box_surface(*min, *max, [segments.0, segments.1, segments.2], Diagonals::Alternating)
+                .map_err(|e| format!("mesh.Box: {e}"))?
+        }
+        MeshSource::File { path } => {
+            let p = base_dir.join(path);
+            let poly = geom_core::io::read_any(&p).map_err(|e| format!("mesh.File {}: {e}", p.display()))?;
+            poly.triangulate_fan().map_err(|e| format!("mesh.File {}: {e}", p.display()))?.0
+        }
+    };
+    if !m.topology().is_closed() {
+        return Err(format!(
+            "the obstacle mesh is not closed ({} boundary edges): it has no inside",
+            m.topology().n_boundary_edges()
+        ));
+    }
+    if let Some(path) = &mo.motion {
+        path.validate().map_err(|e| format!("motion: {e}"))?;
+    }
+    Ok(Obstacle {
+        shape: crate::effects::ObstacleShape::Mesh { verts: m.positions.clone(), tris: m.faces.clone() },
+        friction: mo.friction,
+        motion: mo.motion.clone(),
+    })
 }
 
 /// Area-weighted unit vertex normals (zero for isolated vertices).

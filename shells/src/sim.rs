@@ -2,6 +2,8 @@
 
 use crate::assembly::{Assembler, EvalInput};
 use crate::collision::Collider;
+use crate::contact::Ipc;
+use crate::effects::ContactMethod;
 use crate::effects::{BlockTriplets, Effects};
 use crate::error::{Error, Result};
 use crate::integrator::{DofMap, ImplicitSystem, IntegratorKind, IntegratorSettings, StepStats, VelocitySolve};
@@ -101,6 +103,7 @@ pub struct ShellSim {
     llt: SparseLlt,
     k0: Vec<f64>,
     collider: Option<Collider>,
+    ipc: Option<Ipc>,
     steps: u64,
     energy_ref: f64,
     symbolic_analyses: u32,
@@ -186,7 +189,14 @@ impl ShellSim {
             .effects
             .collision
             .as_ref()
+            .filter(|cs| cs.method == ContactMethod::Bridson)
             .map(|cs| Collider::new(&mesh, &desc.effects, cs, desc.material.membrane.stiffness_scale()));
+        let ipc = desc
+            .effects
+            .collision
+            .as_ref()
+            .filter(|cs| cs.method == ContactMethod::Ipc)
+            .map(|cs| Ipc::new(&mesh, &desc.effects, cs));
         let k0 = mesh.hinges.iter().map(|h| h.stiffness).collect();
         let mut sim = Self {
             mesh,
@@ -201,6 +211,7 @@ impl ShellSim {
             llt,
             k0,
             collider,
+            ipc,
             steps: 0,
             energy_ref: 0.0,
             symbolic_analyses: 1,
@@ -231,6 +242,11 @@ impl ShellSim {
     /// The simulation mesh (rest data, hinges, masses).
     pub fn mesh(&self) -> &ShellMesh {
         &self.mesh
+    }
+
+    /// The effects it was built with.
+    pub fn effects(&self) -> &Effects {
+        &self.effects
     }
 
     /// The material.
@@ -344,9 +360,39 @@ impl ShellSim {
         self.symbolic_analyses
     }
 
+    /// Records, from the next step on, the end-of-step velocities after every stage of the
+    /// collision filter (diagnostics; [`ShellSim::collision_trace`]).
+    pub fn trace_collision_stages(&mut self, on: bool) {
+        if let Some(c) = self.collider.as_mut() {
+            c.trace = on.then(Vec::new);
+        }
+    }
+
+    /// The stages of the last step's collision filter: `(stage, velocities after it)`, in order
+    /// (`solve` first). Positions after a stage are q_k + h·v (backward Euler).
+    pub fn collision_trace(&self) -> &[(&'static str, Vec<Vec3>)] {
+        self.collider.as_ref().and_then(|c| c.trace.as_deref()).unwrap_or(&[])
+    }
+
     /// True when a collision pipeline (and its broad-phase structures) exists.
     pub fn has_collision_structures(&self) -> bool {
-        self.collider.is_some()
+        self.collider.is_some() || self.ipc.is_some()
+    }
+
+    /// The contact model in use (`None` without collision effects).
+    pub fn contact_method(&self) -> Option<ContactMethod> {
+        if self.ipc.is_some() {
+            Some(ContactMethod::Ipc)
+        } else if self.collider.is_some() {
+            Some(ContactMethod::Bridson)
+        } else {
+            None
+        }
+    }
+
+    /// IPC's activation distance d̂ and current barrier stiffness κ (`None` without IPC).
+    pub fn barrier_parameters(&self) -> Option<(f64, f64)> {
+        self.ipc.as_ref().map(|i| (i.dhat, i.kappa))
     }
 
     /// Steps taken since construction.
@@ -448,6 +494,14 @@ impl ShellSim {
         for &(i, p) in &targets {
             let i = i as usize;
             v_cur[i] = if bdf2 || p != q_base[i] { (p - q_base[i]) / h_eff } else { Vec3::zeros() };
+        }
+        if self.ipc.is_some() {
+            let mut ipc = self.ipc.take().expect("checked just above");
+            let r =
+                self.ipc_newton(&mut ipc, &q_base, h_eff, &v_ref, &mut v_cur, &mut targets, h, t_next, solver, &mut st);
+            self.ipc = Some(ipc);
+            r?;
+            return self.finish_step(&q_base, h_eff, v_cur, &targets, h, st);
         }
         // 3–7. Newton iterations.
         let (alpha, bs, bsh, bb) = self.material.damping.coefficients();
@@ -552,9 +606,24 @@ impl ShellSim {
             }
             st.t_collision = tc.elapsed().as_secs_f64();
         }
-        // 9. Update and checks.
+        self.finish_step(&q_base, h_eff, v_cur, &targets, h, st)
+    }
+
+    /// Step 9, the end of a step: positions q_base + h_eff·v (prescribed vertices at their targets),
+    /// the NaN and energy checks, and the state update.
+    fn finish_step(
+        &mut self,
+        q_base: &[Pt3],
+        h_eff: f64,
+        v_cur: Vec<Vec3>,
+        targets: &[(u32, Pt3)],
+        h: f64,
+        st: StepStats,
+    ) -> Result<StepStats> {
+        let n = q_base.len();
+        let t_next = self.state.t + h;
         let mut q_new: Vec<Pt3> = (0..n).map(|i| q_base[i] + h_eff * v_cur[i]).collect();
-        for &(i, p) in &targets {
+        for &(i, p) in targets {
             q_new[i as usize] = p;
         }
         if q_new.iter().any(|p| p.iter().any(|c| !c.is_finite()))
@@ -574,6 +643,270 @@ impl ShellSim {
         self.prev = Some((old, h));
         self.steps += 1;
         Ok(st)
+    }
+
+    /// The IPC Newton solve of one step (module `contact`): a collision-free start (prescribed
+    /// vertices first, then the free vertices' inertial predictor, each as far as CCD allows),
+    /// then Newton iterations on the incremental potential with barrier and lagged friction,
+    /// each step clamped by CCD and backtracked until the potential decreases, until
+    /// ‖Δv‖∞ ≤ `newton_tol`. Prescribed vertices a blocked motion holds back are left where CCD
+    /// stopped them (their `targets` updated) and reported in `StepStats::contact`.
+    #[allow(clippy::too_many_arguments)]
+    fn ipc_newton(
+        &mut self,
+        ipc: &mut Ipc,
+        q_base: &[Pt3],
+        h_eff: f64,
+        v_ref: &[Vec3],
+        v_cur: &mut [Vec3],
+        targets: &mut [(u32, Pt3)],
+        h: f64,
+        t_next: f64,
+        mut solver: Option<&mut dyn VelocitySolve>,
+        st: &mut StepStats,
+    ) -> Result<()> {
+        let n = self.mesh.n_vertices();
+        let qk = self.state.q.clone();
+        let tc = Instant::now();
+        let fr = ipc.begin_step(&qk, t_next, h).map_err(|reason| Error::Diverged { step: self.steps, reason })?;
+        st.contact.friction = fr;
+        // Collision-free start: (A) prescribed vertices toward their targets, (B) the free
+        // vertices' predictor q_base + h_eff v_k, each clamped by CCD from a feasible state.
+        let mut dx = vec![Vec3::zeros(); n];
+        for &(i, p) in targets.iter() {
+            dx[i as usize] = p - qk[i as usize];
+        }
+        let a_pin = if dx.iter().any(|d| *d != Vec3::zeros()) {
+            ipc.sweep(&qk, Some(&dx));
+            ipc.max_step(&qk, &dx)
+        } else {
+            1.0
+        };
+        let mut x: Vec<Pt3> = qk.iter().zip(&dx).map(|(p, d)| p + a_pin * d).collect();
+        if a_pin < 1.0 {
+            st.contact.ccd_clamps += 1;
+            for t in targets.iter_mut() {
+                t.1 = x[t.0 as usize];
+            }
+        }
+        for &(i, p) in targets.iter() {
+            v_cur[i as usize] = (p - q_base[i as usize]) / h_eff;
+        }
+        let free = self.asm.dofs.free_vertices.clone();
+        let mut dx = vec![Vec3::zeros(); n];
+        // The predictor includes gravity (v + h_eff g): a free fall converges in one iteration.
+        let g = self.effects.gravity.unwrap_or_else(Vec3::zeros);
+        for &vtx in &free {
+            let i = vtx as usize;
+            dx[i] = q_base[i] + h_eff * (v_cur[i] + h_eff * g) - x[i];
+        }
+        ipc.sweep(&x, Some(&dx));
+        let a_pred = ipc.max_step(&x, &dx);
+        for &vtx in &free {
+            let i = vtx as usize;
+            x[i] += a_pred * dx[i];
+            v_cur[i] = (x[i] - q_base[i]) / h_eff;
+        }
+        st.t_collision += tc.elapsed().as_secs_f64();
+        let (alpha, bs, bsh, bb) = self.material.damping.coefficients();
+        let nf = self.asm.dofs.n_free();
+        let mut force = vec![Vec3::zeros(); n];
+        let mut converged = false;
+        // Φ of the current iterate, carried over from the accepted trial of the last iteration.
+        let mut phi_cur: Option<f64> = None;
+        for _ in 0..ipc.max_iters {
+            let ta = Instant::now();
+            for i in 0..n {
+                x[i] = q_base[i] + h_eff * v_cur[i];
+            }
+            self.custom_jacobians(t_next, &x, v_cur, h_eff)?;
+            // Contact blocks first: the element pass below gathers them into the matrix.
+            let tcc = Instant::now();
+            let contacts = ipc.contacts(&x);
+            let mut cforce = vec![Vec3::zeros(); n];
+            self.asm.contact_diag.iter_mut().for_each(|d| *d = Mat3::zeros());
+            self.asm.contact_offdiag.clear();
+            {
+                let asm = &mut self.asm;
+                let offsets = &asm.block_offset;
+                let free_index = &asm.dofs.free_index;
+                let (diag, offdiag) = (&mut asm.contact_diag, &mut asm.contact_offdiag);
+                let min_gap = ipc.add(
+                    &x,
+                    &contacts,
+                    &mut cforce,
+                    h_eff * h_eff,
+                    |i, j| offsets.contains_key(&(i, j)),
+                    |i, j, m| {
+                        let (fi, fj) = (free_index[i as usize], free_index[j as usize]);
+                        if fi == NONE || fj == NONE {
+                            return;
+                        }
+                        if i == j {
+                            diag[fi as usize] += m;
+                        } else if let Some(&off) = offsets.get(&(i, j)) {
+                            offdiag.push((off, m));
+                        }
+                    },
+                );
+                st.contact.min_gap = min_gap;
+            }
+            st.contact.active = contacts.len() as u32;
+            st.t_collision += tcc.elapsed().as_secs_f64();
+            let inp = EvalInput {
+                q: &x,
+                v: v_cur,
+                h_eff,
+                mode: self.settings.hessian,
+                law: &self.law,
+                damping: (alpha, bs, bsh, bb),
+                wind: self.wind.as_ref().map(|w| (w, t_next)),
+                shift: 0.0,
+            };
+            let out = self.asm.assemble(&self.mesh, &inp, &mut force);
+            st.skipped_hinges = out.skipped_hinges;
+            st.collapsed_triangles = out.collapsed_triangles;
+            self.add_external_forces(t_next, &x, v_cur, &mut force);
+            let mut b = vec![0.0; 3 * nf];
+            for (fidx, &vtx) in free.iter().enumerate() {
+                let i = vtx as usize;
+                let m = self.mesh.mass[i];
+                let r = -m * (v_cur[i] - v_ref[i]) + h_eff * (force[i] + cforce[i] - alpha * m * v_cur[i]);
+                b[3 * fidx..3 * fidx + 3].copy_from_slice(r.as_slice());
+            }
+            st.t_assembly += ta.elapsed().as_secs_f64();
+            if nf == 0 {
+                converged = true;
+                break;
+            }
+            let dv = match solver.as_deref_mut() {
+                Some(s) => {
+                    let ts = Instant::now();
+                    let sys = ImplicitSystem {
+                        a: self.asm.matrix(),
+                        b: &b,
+                        q_pred: &x,
+                        v0: v_cur,
+                        h_eff,
+                        dofs: &self.asm.dofs,
+                        h,
+                        t_next,
+                    };
+                    let dv = s.solve(&sys)?;
+                    if dv.len() != 3 * nf || dv.iter().any(|x| !x.is_finite()) {
+                        return Err(Error::Diverged {
+                            step: self.steps,
+                            reason: "delegated solve returned a bad Δv".into(),
+                        });
+                    }
+                    st.t_solve += ts.elapsed().as_secs_f64();
+                    dv
+                }
+                None => self.solve_system(&b, h_eff, alpha, st)?,
+            };
+            st.lin_residual = rel_residual(self.asm.matrix(), &dv, &b);
+            st.newton_iters += 1;
+            let dv_max = dv.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            // CCD bound, then backtracking on Φ (barrier and friction included).
+            let tl = Instant::now();
+            let mut step_dx = vec![Vec3::zeros(); n];
+            for (fidx, &vtx) in free.iter().enumerate() {
+                step_dx[vtx as usize] = h_eff * Vec3::new(dv[3 * fidx], dv[3 * fidx + 1], dv[3 * fidx + 2]);
+            }
+            ipc.sweep(&x, Some(&step_dx));
+            let mut a = ipc.max_step(&x, &step_dx);
+            if a < 1.0 {
+                st.contact.ccd_clamps += 1;
+            }
+            if a == 0.0 {
+                // Blocked: a pair at the gap floor would close further (a conflict that keeps
+                // pushing, e.g. a tracking constraint into an obstacle): contact wins.
+                st.t_collision += tl.elapsed().as_secs_f64();
+                break;
+            }
+            if dv_max <= ipc.newton_tol {
+                // Converged: take the (CCD-safe) step without a line search.
+                for (fidx, &vtx) in free.iter().enumerate() {
+                    let i = vtx as usize;
+                    v_cur[i] += a * Vec3::new(dv[3 * fidx], dv[3 * fidx + 1], dv[3 * fidx + 2]);
+                }
+                converged = true;
+                st.t_collision += tl.elapsed().as_secs_f64();
+                break;
+            }
+            let phi0 = match phi_cur {
+                Some(p) => p,
+                None => self.ipc_potential(ipc, q_base, h_eff, v_ref, v_cur, t_next, alpha),
+            };
+            let mut trial = v_cur.to_vec();
+            let mut accepted = false;
+            let mut phi = phi0;
+            for _ in 0..30 {
+                for (fidx, &vtx) in free.iter().enumerate() {
+                    let i = vtx as usize;
+                    trial[i] = v_cur[i] + a * Vec3::new(dv[3 * fidx], dv[3 * fidx + 1], dv[3 * fidx + 2]);
+                }
+                phi = self.ipc_potential(ipc, q_base, h_eff, v_ref, &trial, t_next, alpha);
+                if phi <= phi0 {
+                    accepted = true;
+                    break;
+                }
+                a *= 0.5;
+                st.line_search_halvings += 1;
+            }
+            if !accepted {
+                // No decrease found (the frozen damping makes Δv inexact for Φ): keep the
+                // smallest CCD-safe step tried; counted.
+                st.contact.line_search_failures += 1;
+            }
+            v_cur.copy_from_slice(&trial);
+            phi_cur = Some(phi);
+            if std::env::var_os("SHELLS_IPC_DEBUG").is_some() {
+                eprintln!(
+                    "  iter {}: |dv| {dv_max:.3e} alpha {a:.3e} contacts {} phi0 {phi0:.6e}",
+                    st.newton_iters,
+                    contacts.len()
+                );
+            }
+            st.t_collision += tl.elapsed().as_secs_f64();
+            if dv_max <= ipc.newton_tol {
+                converged = true;
+                break;
+            }
+        }
+        if !converged {
+            st.contact.unconverged += 1;
+        }
+        // Statistics at the accepted end state; κ grows while gaps get too small.
+        for i in 0..n {
+            x[i] = q_base[i] + h_eff * v_cur[i];
+        }
+        let end = ipc.contacts(&x);
+        st.contact.active = end.len() as u32;
+        st.contact.min_gap = end.iter().map(|c| c.gap(&x).d).fold(f64::INFINITY, f64::min);
+        ipc.adapt_kappa(st.contact.min_gap);
+        st.contact.kappa = ipc.kappa;
+        Ok(())
+    }
+
+    /// Φ(v) of the IPC line search: the incremental potential of [`ShellSim::incremental_potential`]
+    /// plus mass damping ½hα·Σm|v|² and contact (barrier + lagged friction) energy.
+    #[allow(clippy::too_many_arguments)]
+    fn ipc_potential(&self, ipc: &Ipc, q_base: &[Pt3], h: f64, v_ref: &[Vec3], v: &[Vec3], t: f64, alpha: f64) -> f64 {
+        let q: Vec<Pt3> = q_base.iter().zip(v).map(|(p, vv)| p + h * vv).collect();
+        let damp: f64 = if alpha > 0.0 {
+            0.5 * h
+                * alpha
+                * v.iter()
+                    .zip(&self.mesh.mass)
+                    .zip(&self.inv_mass)
+                    .filter(|(_, &im)| im > 0.0)
+                    .map(|((v, m), _)| m * v.norm_squared())
+                    .sum::<f64>()
+        } else {
+            0.0
+        };
+        self.incremental_potential(q_base, h, v_ref, v, t) + damp + ipc.energy(&q)
     }
 
     /// Redoes the end of the last (backward Euler) step with other end-of-step velocities:
@@ -606,6 +939,25 @@ impl ShellSim {
         let mut st = StepStats::default();
         let mut v: Vec<Vec3> =
             (0..n).map(|i| if self.inv_mass[i] > 0.0 { v_new[i] } else { self.state.v[i] }).collect();
+        if let Some(ipc) = self.ipc.as_mut() {
+            // IPC: from the (collision-free) end of the step toward q_k + h·v, as far as CCD
+            // allows — contact keeps priority, and no gap closes below its CCD fraction.
+            let tc = Instant::now();
+            let x = &self.state.q;
+            let dx: Vec<Vec3> =
+                (0..n).map(|i| if self.inv_mass[i] > 0.0 { qk[i] + h * v[i] - x[i] } else { Vec3::zeros() }).collect();
+            ipc.sweep(x, Some(&dx));
+            let a = ipc.max_step(x, &dx);
+            if a < 1.0 {
+                st.contact.ccd_clamps += 1;
+            }
+            for i in 0..n {
+                if self.inv_mass[i] > 0.0 {
+                    v[i] = (x[i] + a * dx[i] - qk[i]) / h;
+                }
+            }
+            st.t_collision = tc.elapsed().as_secs_f64();
+        }
         if let Some(col) = self.collider.as_mut() {
             let tc = Instant::now();
             col.filter(qk, &mut v, h, t_next, &self.inv_mass, &mut st);

@@ -46,8 +46,13 @@ fn static_test_tiny() {
     let p: static_test::Params = params("static");
     let r = tiny("static", &p, static_test::run);
     assert_eq!(r.get_f64("e_star"), 0.0, "matched, noise-free: E(p*) = 0 exactly");
-    assert!(r.get_f64("stiff_err_matched").is_finite() || r.get_f64("stiff_err_matched").is_nan());
+    let be = r.get_f64("bend_err_matched_linen");
+    assert!(be.is_finite() && be >= 0.0, "bend error {be}");
     assert!(r.get_f64("static_bend_variability_linen") >= 0.0);
+    // The settle runs with a fixed damping, so the static shape cannot depend on the fabric's
+    // damping: the paper's finding (damping variability > 20 %) holds by construction.
+    let dv = r.get_f64("static_damping_variability_min");
+    assert!(dv > 0.2, "static damping variability {dv}");
 }
 
 #[test]

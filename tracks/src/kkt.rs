@@ -99,6 +99,8 @@ pub enum KktMethod {
 pub struct KktStats {
     /// Wall time of the constrained solve (assembly of the KKT values, factorisation, solve) (s).
     pub t_kkt: f64,
+    /// Constrained solves in the step (its Newton iterations).
+    pub solves: u32,
     /// Wall time of the unused shadow LLᵀ of A (s), 0 unless shadow timing is on.
     pub t_shadow_llt: f64,
     /// max_i ‖g_i(q⁰ + h_eff Δv)‖ (m): the constraint residual before collisions.
@@ -227,6 +229,14 @@ impl TrackingSolver {
             gbuf: vec![Pt3::origin(); nb],
             last: KktStats::default(),
         }
+    }
+
+    /// Starts a step: the time statistics of [`KktStats`] sum over the step's solves (one per
+    /// Newton iteration of the IPC contact model).
+    pub fn begin_step(&mut self) {
+        self.last.t_kkt = 0.0;
+        self.last.t_shadow_llt = 0.0;
+        self.last.solves = 0;
     }
 
     /// The constraints this solver enforces.
@@ -695,7 +705,10 @@ impl VelocitySolve for TrackingSolver {
         let c = self.correction_fraction / sys.h_eff;
         let r: Vec<f64> = g.iter().flat_map(|gi| [c * gi.x, c * gi.y, c * gi.z]).collect();
         let (dv, mu) = self.solve_method(sys, &r)?;
-        self.last.t_kkt = t0.elapsed().as_secs_f64();
+        self.last.solves += 1;
+        // Summed over the step's Newton iterations (IPC solves one KKT system per iteration;
+        // `begin_step` resets).
+        self.last.t_kkt += t0.elapsed().as_secs_f64();
         // Residual before collisions: g(q⁰ + h_eff Δv) on every vertex (constrained ones at q⁰).
         let mut q_end = sys.q_pred.to_vec();
         for (f, &v) in sys.dofs.free_vertices.iter().enumerate() {
@@ -710,7 +723,7 @@ impl VelocitySolve for TrackingSolver {
             let ts = Instant::now();
             let llt = self.shadow_llt.get_or_insert_with(|| SparseLlt::from_symbolic(&self.a_symbolic));
             llt.factor(sys.a).map_err(core)?;
-            self.last.t_shadow_llt = ts.elapsed().as_secs_f64();
+            self.last.t_shadow_llt += ts.elapsed().as_secs_f64();
         }
         let scale = dv.iter().fold(0.0f64, |a, x| a.max(x.abs())).max(1e-300);
         let mut compare = Vec::with_capacity(self.shadows.len());

@@ -117,8 +117,8 @@ impl Tracker {
     /// Builds constraints from `tf`, checks them against the simulation's free DOFs and
     /// optionally projects the initial state (§3.5).
     ///
-    /// Errors: `BadParameter` for `newton_iters ≠ 1` (the delegated solve replaces only the
-    /// first Newton iteration of `shells`) or `correction_fraction ∉ (0, 1]`;
+    /// Errors: `BadParameter` for `newton_iters ≠ 1` without IPC contact (the delegated solve
+    /// then replaces only the first Newton iteration of `shells`) or `correction_fraction ∉ (0, 1]`;
     /// `TopologyMismatch`, `ZeroIntegral`, `RankDeficient`, `InfeasibleConstraint` from setup.
     pub fn new(
         mut sim: ShellSim,
@@ -127,9 +127,11 @@ impl Tracker {
         prolongation: Option<Csr>,
         opts: TrackOptions,
     ) -> Result<Self> {
-        if sim.settings_mut().newton_iters != 1 {
+        // With the Bridson filter only the first Newton solve is delegated; the IPC contact
+        // model delegates every iteration's solve, so any iteration count works there.
+        if sim.contact_method() != Some(shells::ContactMethod::Ipc) && sim.settings_mut().newton_iters != 1 {
             return Err(TrackError::BadParameter(format!(
-                "tracking needs newton_iters = 1 (got {}): only the first Newton solve is constrained",
+                "tracking needs newton_iters = 1 (got {}) without IPC contact: only the first Newton solve is constrained",
                 sim.settings_mut().newton_iters
             )));
         }
@@ -297,6 +299,7 @@ impl Tracker {
                 out.shell = self.sim.step(h)?;
             }
             Some(s) => {
+                s.begin_step();
                 out.shell = self.sim.step_with(h, s)?;
                 let l = &s.last;
                 out.t_kkt = l.t_kkt;

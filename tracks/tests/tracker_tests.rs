@@ -392,24 +392,30 @@ fn shift_residual_test_adds_refinement() {
 }
 
 /// §3.7 step 5 (`reproject_after_collisions`) on the waving sheet (the guide dips to y ≈ −0.093 m)
-/// over a ground plane. After the collision pass the velocities are corrected by W Ĉᵀ G⁻¹ g / h
-/// and the collision pass is rerun, so collision-freedom keeps priority: no vertex ever ends below
-/// the plane. (a) Floor at −0.095 m, initial state projected: contact only grazes the tracked
-/// sheet at the start, the constraints stay feasible, and the reprojection removes most of what
-/// the collision pass left (measured over 120 steps: mean r_post 2.2e-6 → 7.6e-7 m). (b) Floor at
-/// −0.05 m, flat start: the guide asks for positions inside the floor — an infeasible conflict —
-/// and the residual stays (1.12e-2 → 1.11e-2 m): the correction is undone by the rerun pass
-/// instead of pushing the cloth through.
+/// over a ground plane, with both contact models.
+///
+/// Bridson's velocity filter runs after the constrained solve: (a) floor at −0.095 m, initial
+/// state projected: contact only grazes the tracked sheet at the start, the constraints stay
+/// feasible, and the reprojection removes most of what the collision pass left (measured over
+/// 120 steps: mean r_post 2.2e-6 → 7.6e-7 m); (b) floor at −0.05 m, flat start: the guide asks
+/// for positions inside the floor — an infeasible conflict — and the residual stays
+/// (1.12e-2 → 1.11e-2 m): the correction is undone by the rerun pass instead of pushing the
+/// cloth through.
+///
+/// IPC puts the barrier inside the constrained Newton solve, so (a) the feasible case leaves no
+/// residual for the reprojection to remove (r_post at solver precision), and (b) in the
+/// infeasible case the barrier wins: the residual stays large and no vertex goes below the floor.
+/// Either way collision-freedom keeps priority.
 #[test]
 fn reprojection_after_collisions() {
-    use shells::{CollisionSettings, Obstacle, ObstacleShape};
-    let run = |floor: f64, project: bool, reproject: bool| {
+    use shells::{CollisionSettings, ContactMethod, Obstacle, ObstacleShape};
+    let run = |method: ContactMethod, floor: f64, project: bool, reproject: bool| {
         let plane =
             Obstacle { shape: ObstacleShape::Plane { normal: Vec3::y(), offset: floor }, friction: 0.5, motion: None };
         let effects = Effects {
             gravity: Some(Vec3::new(0.0, -9.81, 0.0)),
             obstacles: vec![plane],
-            collision: Some(CollisionSettings::default()),
+            collision: Some(CollisionSettings { method, ..Default::default() }),
             ..Effects::default()
         };
         let opts = TrackOptions {
@@ -417,7 +423,7 @@ fn reprojection_after_collisions() {
             project_initial_state: project,
             ..TrackOptions::default()
         };
-        let (mut tr, _) = tracker_with(opts, 2, effects);
+        let (mut tr, l) = tracker_with(opts, 2, effects);
         let (mut first, mut last, mut ran) = (0.0, 0.0, 0);
         for _ in 0..120 {
             let s = tr.step(1.0 / 120.0).expect("step");
@@ -425,19 +431,29 @@ fn reprojection_after_collisions() {
             last += s.residual_post_collision;
             ran += usize::from(s.reprojected);
             let low = tr.sim.state().q.iter().map(|q| q.y).fold(f64::INFINITY, f64::min);
-            assert!(low >= floor - 1e-9, "vertex at y = {low} below the floor {floor} at t = {}", tr.sim.state().t);
+            assert!(
+                low >= floor - 1e-9,
+                "{method:?}: vertex at y = {low} below the floor {floor} at t = {}",
+                tr.sim.state().t
+            );
         }
-        (first / 120.0, last / 120.0, ran)
+        (first / 120.0, last / 120.0, ran, l)
     };
     // Option off: nothing runs, both residuals are the same number.
-    let (first, last, ran) = run(-0.095, true, false);
+    let (first, last, ran, _) = run(ContactMethod::Bridson, -0.095, true, false);
     assert_eq!((ran, first), (0, last));
-    // (a) feasible: the reprojection removes at least half of the post-collision residual.
-    let (first, last, ran) = run(-0.095, true, true);
+    // Bridson (a) feasible: the reprojection removes at least half of the post-collision residual.
+    let (first, last, ran, _) = run(ContactMethod::Bridson, -0.095, true, true);
     assert!(ran > 0 && first > 1e-7, "contact must disturb the tracking (ran {ran}, r {first:e})");
     assert!(last < 0.5 * first, "feasible: mean r_post {last:e} vs first pass {first:e}");
-    // (b) infeasible: collisions win; the residual is not made worse.
-    let (first, last, ran) = run(-0.05, false, true);
+    // Bridson (b) infeasible: collisions win; the residual is not made worse.
+    let (first, last, ran, _) = run(ContactMethod::Bridson, -0.05, false, true);
     assert!(ran > 0 && first > 1e-3, "the floor must conflict with the guide (r {first:e})");
     assert!(last <= 1.01 * first, "infeasible: mean r_post {last:e} vs first pass {first:e}");
+    // IPC (a) feasible: constraints and contact are solved together.
+    let (first, last, _, l) = run(ContactMethod::Ipc, -0.095, true, true);
+    assert!(first <= 1e-9 * l && last <= 1e-9 * l, "IPC feasible: mean r {first:e}, {last:e} (L = {l})");
+    // IPC (b) infeasible: the barrier wins, the conflict stays visible in the residual.
+    let (first, last, _, _) = run(ContactMethod::Ipc, -0.05, false, true);
+    assert!(first > 1e-3 && last <= 1.01 * first, "IPC infeasible: mean r {first:e} → {last:e}");
 }

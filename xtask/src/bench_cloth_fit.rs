@@ -74,7 +74,7 @@ fn settings(sweep: &str, quick: bool) -> Vec<Knob> {
             b.iter().map(|&e| Knob { anneal_evals: Some(e), ..k(&format!("evals{e}")) }).collect()
         }
         "coarse" => vec![
-            Knob { coarse: Some(CoarseSearch::None), ..k("none") },
+            Knob { coarse: Some(CoarseSearch::Off), ..k("none") },
             Knob { coarse: Some(CoarseSearch::LatinHypercube { samples: 8, seed: 1 }), ..k("lhs8") },
             Knob {
                 coarse: Some(CoarseSearch::Grid { values_per_param: 2, params: ParamId::STIFFNESS.to_vec() }),

@@ -37,9 +37,6 @@ pub struct FileRecorder {
     pub scene: Vec<SceneItem>,
     /// Mesh frames written per sequence (count).
     pub frames_written: BTreeMap<String, usize>,
-    /// Progress bar of the run's main loop (created by the first `progress` call; hidden when
-    /// stderr is not a terminal).
-    bar: Option<indicatif::ProgressBar>,
 }
 
 fn core_io(path: &Path) -> impl FnOnce(std::io::Error) -> geom_core::Error + '_ {
@@ -67,7 +64,6 @@ impl FileRecorder {
             notes: None,
             scene: Vec::new(),
             frames_written: BTreeMap::new(),
-            bar: None,
         })
     }
 
@@ -76,15 +72,13 @@ impl FileRecorder {
         &self.dir
     }
 
-    /// Draws the plots (one PNG per plot name). Call once when the experiment returns.
+    /// Draws the plots (one PNG per plot name) and keeps the scene items in `scene.json` (for
+    /// previews and reports rebuilt later). Call once when the experiment returns.
     pub fn finish(&mut self) -> Result<()> {
-        if let Some(b) = self.bar.take() {
-            b.finish_and_clear();
-        }
         for (name, p) in &self.plots {
             p.write_png(&self.dir.join(format!("{name}.png")))?;
         }
-        Ok(())
+        crate::scene_items::write(&self.dir, &self.scene)
     }
 }
 
@@ -153,16 +147,7 @@ impl Recorder for FileRecorder {
     }
 
     fn progress(&mut self, done: u64, total: u64) {
-        let bar = self.bar.get_or_insert_with(|| {
-            let b = indicatif::ProgressBar::new(total);
-            b.set_style(
-                indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {pos}/{len} (eta {eta})")
-                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-            );
-            b
-        });
-        bar.set_length(total);
-        bar.set_position(done.min(total));
+        crate::ui::progress(done, total);
     }
 
     fn file(&mut self, name: &str, bytes: &[u8]) -> geom_core::Result<()> {
@@ -210,8 +195,10 @@ where
 {
     let sc = scene::load::<P>(&ctx.scene_file)?;
     let mut rec = FileRecorder::new(&ctx.out_dir)?;
-    let report = f(&sc.params, ctx.mode.size(), &mut rec)?;
+    let report = f(&sc.params, ctx.mode.size(), &mut rec);
+    // The scene items and plots of a failed run are kept too (the frames already are).
     rec.finish()?;
+    let report = report?;
     write_checks(&ctx.out_dir, &report)?;
     Ok(Summary::from_report(&report))
 }

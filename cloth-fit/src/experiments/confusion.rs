@@ -123,7 +123,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let cell = 24u32;
     let mut img = ImageF32::new(n as u32 * cell, n as u32 * cell, 1.0);
     for (i, row) in m.iter().enumerate() {
-        let mx = row.iter().cloned().fold(0.0f64, f64::max);
+        let mx = geom_core::stats::max(row);
         for (j, &v) in row.iter().enumerate() {
             let g = if mx > 0.0 { (v / mx) as f32 } else { 0.0 };
             for y in 1..cell - 1 {

@@ -94,6 +94,9 @@ pub(crate) struct Collider {
     /// Velocity u of the translating frame in which the CCD broad phase sweeps its boxes
     /// (fixed at the first CCD of a filter call; see [`Collider::ccd_pairs`]).
     frame: Option<Vec3>,
+    /// When set, the velocities after every stage of [`Collider::filter`] (diagnostics: which
+    /// stage adds energy or lets vertices through; see `examples/contact_stages.rs`).
+    pub(crate) trace: Option<Vec<(&'static str, Vec<Vec3>)>>,
 }
 
 /// Candidate pairs of swept boxes grown by an extra slack s around the end points q + h v_ref:
@@ -156,6 +159,13 @@ impl Collider {
             near: Vec::new(),
             superset: None,
             frame: None,
+            trace: None,
+        }
+    }
+
+    fn snap(&mut self, stage: &'static str, v: &[Vec3]) {
+        if let Some(t) = self.trace.as_mut() {
+            t.push((stage, v.to_vec()));
         }
     }
 
@@ -168,10 +178,16 @@ impl Collider {
         }
         self.broad.next_step();
         self.reset_call_state(n);
+        if let Some(t) = self.trace.as_mut() {
+            t.clear();
+        }
+        self.snap("solve", v);
         if self.self_collision {
             self.proximity(q, v, h, im, st);
+            self.snap("proximity", v);
         }
         self.obstacle_pass(q, v, h, t_next, im, st);
+        self.snap("obstacles", v);
         if !self.self_collision {
             return;
         }
@@ -192,6 +208,7 @@ impl Collider {
                     })
                     .collect();
                 apply(&reqs, v, im, n);
+                self.snap("ccd", v);
             }
             remaining = self.ccd_hits(q, v, h);
         }
@@ -339,12 +356,14 @@ impl Collider {
                     let rel = v[i] - vo;
                     let vn = rel.dot(&nrm);
                     // Below h_c: no approach plus a small separation; farther: stop at 0.9 h_c.
+                    // (A former extra clamp, max(vn_min, min(h_c(1 − f) − min(d₀, d_end), 0)/h),
+                    // was 0 whenever the end point came within 0.9 h_c, stopping vertices up to a
+                    // whole step's travel away: the first source of energy in fold-stress.)
                     let vn_min = if p0.distance < hc {
                         (fsep * (hc - p0.distance) / h).max(0.0)
                     } else {
                         (0.9 * hc - p0.distance) / h
                     };
-                    let vn_min = vn_min.max((hc * (1.0 - fsep) - pe.distance.min(p0.distance)).min(0.0) / h);
                     if vn >= vn_min {
                         return None;
                     }
@@ -647,6 +666,7 @@ impl Collider {
                 dirty[uf.find(x) as usize] = true;
             }
             self.rigidify(q, v, im, &mut uf, &in_zone, &dirty, st);
+            self.snap("zones", v);
             hits = self.ccd_hits(q, v, h);
             if hits.is_empty() {
                 return;
@@ -679,6 +699,7 @@ impl Collider {
             }
         }
         st.n_frozen += frozen.iter().filter(|&&f| f).count() as u32;
+        self.snap("freeze", v);
     }
 
     /// Sets the velocities of every zone whose root is `dirty` to its rigid motion (constrained

@@ -1,4 +1,8 @@
-//! Thin per-crate adapters onto [`crate::record::run_experiment`] (issue 21): each module maps
-//! scene methods to a method crate's `experiments::<scene>::run` and converts its error type.
+//! Per-crate adapters (issue 21): each loads a scene's `params` block, calls the crate's
+//! experiment with a file recorder ([`crate::record::run_experiment`]) and returns the figures
+//! of `summary.json`. Each module's `register` adds its runners.
 
 pub mod cloth_fit;
+pub mod flip_tet;
+pub mod motion_graph;
+pub mod rigging;

@@ -36,6 +36,18 @@ pub fn register(v: &mut Vec<Runner>) {
     v.push(Runner { method: "shells/fold-stress", run: run_fold });
     v.push(Runner { method: "shells/plastic-crease", run: run_plastic });
     v.push(Runner { method: "shells/wind-flag", run: run_wind });
+    v.push(Runner { method: "shells/contact", run: run_contact });
+}
+
+impl From<shells::Error> for Error {
+    fn from(e: shells::Error) -> Self {
+        Error::Run(format!("shells: {e}"))
+    }
+}
+
+/// The contact suite (`shells::experiments::contact`).
+fn run_contact(ctx: &RunCtx) -> Result<Summary> {
+    crate::record::run_experiment(ctx, shells::experiments::contact::run)
 }
 
 fn err(e: shells::Error) -> Error {
