@@ -80,11 +80,10 @@ pub fn coarse_points(c: &CoarseSearch, free: &[ParamId], base: &[f64]) -> Result
                     v
                 })
                 .collect();
-            let mut pts = Vec::with_capacity(*samples);
-            for s in 0..*samples {
-                let x: Vec<f64> = (0..n).map(|d| (cols[d][s] as f64 + rng.f64()) / *samples as f64).collect();
-                pts.push(x);
-            }
+            // Sample-major, dimension-minor: the order the rng is drawn in.
+            let pts: Vec<Vec<f64>> = (0..*samples)
+                .map(|s| cols.iter().map(|c| (c[s] as f64 + rng.f64()) / *samples as f64).collect())
+                .collect();
             Ok(pts)
         }
     }

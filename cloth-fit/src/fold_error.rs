@@ -133,7 +133,7 @@ mod tests {
         let none = frame(0.3, &[true, true, true, false], &[false, false, false, false]);
         assert_eq!(frame_error(&none, &c, &MetricOptions { mask: MaskMode::Real, ..o }).unwrap().fold, 0.0);
         assert!(frame_error(&none, &c, &o).unwrap().fold > 0.0);
-        assert!(matches!(sequence_error(&[a.clone()], &[], &o), Err(FitError::SequenceMismatch { .. })));
+        assert!(matches!(sequence_error(std::slice::from_ref(&a), &[], &o), Err(FitError::SequenceMismatch { .. })));
     }
 
     /// Spec §8: an empty silhouette in one frame gives E_fold = 0 and E_silh = the other area.

@@ -384,7 +384,7 @@ impl ShellsForward {
             let t = (steps + 1) as f64 * dt;
             sim.step(dt).map_err(sim_err(t))?;
             steps += 1;
-            if steps % 16 == 0 {
+            if steps.is_multiple_of(16) {
                 check(&sim.state().q, t)?;
             }
             if steps >= n_min && sim.energies().kinetic / mass < e.settle.ke_per_mass {
@@ -442,7 +442,7 @@ impl ShellsForward {
                 k += 1;
                 steps += 1;
                 let t1 = k as f64 * dt;
-                if k % 16 == 0 {
+                if k.is_multiple_of(16) {
                     check(&stepper.state().q, settle_s + t1)?;
                 }
                 sampler.offer(t0, &q0, t1, &stepper.state().q);

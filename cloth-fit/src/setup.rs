@@ -121,8 +121,12 @@ impl Experiment {
     /// Checks every value before any simulation.
     pub fn validate(&self) -> Result<()> {
         let s = &self.swatch;
-        if !(s.width > 0.0 && s.height > 0.0 && s.areal_density > 0.0)
-            || !(s.width.is_finite() && s.height.is_finite() && s.areal_density.is_finite())
+        if !(s.width > 0.0
+            && s.height > 0.0
+            && s.areal_density > 0.0
+            && s.width.is_finite()
+            && s.height.is_finite()
+            && s.areal_density.is_finite())
         {
             return Err(FitError::BadParameter(format!(
                 "swatch: width, height and areal density must be finite and > 0, got {s:?}"

@@ -128,10 +128,10 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     })?;
     let minima = local_minima(&grid);
     let (mut bi, mut bj, mut bv) = (0, 0, f64::INFINITY);
-    for i in 0..n {
-        for j in 0..n {
-            if grid[i][j] < bv {
-                (bi, bj, bv) = (i, j, grid[i][j]);
+    for (i, row) in grid.iter().enumerate() {
+        for (j, &v) in row.iter().enumerate() {
+            if v < bv {
+                (bi, bj, bv) = (i, j, v);
             }
         }
     }

@@ -147,14 +147,14 @@ pub fn run_knob(
     let cond = p.condition.get(size);
     let frames = p.frames.get(size).max(2);
     let nv = p.validation_frames.get(size);
-    if !footage.contains_key(&image) {
+    if let std::collections::btree_map::Entry::Vacant(slot) = footage.entry(image) {
         // The footage does not depend on the fitting model: render it with the base model.
         let base = EvalSetup { model: p.fit.setup(size)?.model, ..setup.clone() };
         let src = SyntheticSource::new(cond, truth, &base, p.fit.noise);
         let t = synthesize(&fwd, &waving_trial(f, 0, frames), &base.rig, &src, &base.angle)?;
         let v =
             if nv > 0 { Some(synthesize(&fwd, &validation_trial(f, nv), &base.rig, &src, &base.angle)?) } else { None };
-        footage.insert(image, (t, v));
+        slot.insert((t, v));
     }
     let (t, v) = &footage[&image];
     let mut target = t.target.clone();

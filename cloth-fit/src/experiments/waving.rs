@@ -102,10 +102,13 @@ pub struct WavingFit {
     /// Variability at the chosen point: (static test, waving test), when enabled.
     pub var: Option<(Vec<ParamVariability>, Vec<ParamVariability>)>,
     /// Validation: (ratio, E_val(p̂), E_val(p*), truth frames, fit frames), when enabled.
-    pub val: Option<(f64, f64, f64, Vec<ImageF32>, Vec<ImageF32>)>,
+    pub val: Option<Validation>,
     /// Trial 1's truth and fit frames (for the strip).
     pub strip: (Vec<ImageF32>, Vec<ImageF32>),
 }
+
+/// A validation result: (ratio, E_val(p̂), E_val(p*), truth frames, fit frames).
+pub type Validation = (f64, f64, f64, Vec<ImageF32>, Vec<ImageF32>);
 
 /// Runs the waving protocol for one fabric (no recording; `progress` sees the fit's batches).
 pub fn fit_fabric(p: &Params, size: Size, f: FabricPreset, progress: &mut dyn FnMut(u64, u64)) -> Result<WavingFit> {
