@@ -6,6 +6,7 @@
 mod ui;
 
 mod bench_barnet;
+mod bench_cloth_fit;
 mod bench_curve_skin;
 mod bench_flip_tet;
 mod bench_geom_core;

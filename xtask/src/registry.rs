@@ -87,6 +87,7 @@ pub fn runners() -> Vec<Runner> {
     crate::crates::perf_control::register(&mut v);
     crate::crates::flip_tet::register(&mut v);
     crate::crates::wrinkles::register(&mut v);
+    crate::crates::cloth_fit::register(&mut v);
     v
 }
 
@@ -152,6 +153,12 @@ pub fn benches() -> Vec<Bench> {
             description: "wrinkles: quadrature tolerance, gradient bins, mode, smoothing and subdivision level vs coefficient/h/area error and time",
             run: crate::bench_wrinkles::run,
             sweeps: &[],
+        },
+        Bench {
+            crate_name: "cloth-fit",
+            description: "cloth-fit: annealing budget, coarse search, mesh and image resolution, dt vs parameter error and wall time; evaluation cost by stage; anytime curve",
+            run: crate::bench_cloth_fit::run,
+            sweeps: crate::bench_cloth_fit::SWEEPS,
         },
     ]
 }

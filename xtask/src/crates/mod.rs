@@ -13,6 +13,7 @@ use crate::registry::RunCtx;
 use crate::scene;
 
 pub mod barnet;
+pub mod cloth_fit;
 pub mod curve_skin;
 pub mod flip_tet;
 pub mod geom_core;
