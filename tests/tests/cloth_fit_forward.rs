@@ -4,9 +4,6 @@
 //! run here until the search recovers bend.
 
 use cloth_fit::angle::AngleOptions;
-use cloth_fit::anneal::AnnealOptions;
-use cloth_fit::coarse::CoarseSearch;
-use cloth_fit::fit::{fit, DynamicInit, FitOptions, TrialPolicy};
 use cloth_fit::forward::{swatch_mesh, ForwardModel, ShellsForward, SimOptions};
 use cloth_fit::objective::{EvalSetup, Objective};
 use cloth_fit::params::{ParamId, ParamSpace};
