@@ -12,6 +12,7 @@ mod bench_rigging;
 mod bench_shells;
 mod bench_tracks;
 mod bench_wrinkles;
+mod crates;
 mod error;
 mod inspect;
 mod out;

@@ -11,7 +11,6 @@ pub mod geom_core;
 pub mod motion_graph;
 pub mod perf_control;
 pub mod rigging;
-pub mod shells;
 pub mod tracks;
 pub mod tracks_variants;
 pub mod wrinkles;
