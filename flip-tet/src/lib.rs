@@ -6,13 +6,16 @@
 pub mod advect;
 pub mod bcc;
 pub mod error;
+pub mod experiments;
 #[cfg(feature = "fvm-baseline")]
 pub mod fvm_baseline;
 pub mod metrics;
 pub mod octree;
 pub mod ops;
 pub mod particles;
+pub mod presets;
 pub mod pressure;
+pub mod reference;
 pub mod scene;
 pub mod sim;
 pub mod sizing;

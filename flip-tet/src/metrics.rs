@@ -1,56 +1,24 @@
-//! Probes and CSV rows (spec §6): surge-front position, residual column height, surface height
-//! from a vertical root search of φ, zero-crossing period, and the per-step `metrics.csv` row.
+//! Every figure a flip-tet scene reports (spec §6): probes (surge-front position, residual
+//! column height, surface height from a vertical root search of φ), signal analysis
+//! (zero-crossing period, damping ratio), run statistics (relative drifts, particle-count
+//! figures, the per-step `metrics.csv` row) and the comparisons with reference data.
+//!
+//! Maxima and drifts are NaN-safe: a NaN anywhere makes the figure NaN.
 
+use geom_core::experiment::Report;
 use geom_core::math::Pt3;
+use geom_core::stats;
 
 use crate::particles::Particles;
 use crate::sim::{FlipTetSim, StepStats};
 
-/// Martin & Moyce (1952), Phil. Trans. R. Soc. A 244, Fig./Table for `a = 2¼ in`, `n² = 2`
-/// (spec §6 S2): dimensionless surge front `Z = x_front / a` at `T = t √(2g/a)`.
-pub const MARTIN_MOYCE_FRONT: [(f64, f64); 15] = [
-    (0.41, 1.11),
-    (0.84, 1.22),
-    (1.19, 1.44),
-    (1.43, 1.67),
-    (1.63, 1.89),
-    (1.83, 2.11),
-    (1.98, 2.33),
-    (2.20, 2.56),
-    (2.32, 2.78),
-    (2.51, 3.00),
-    (2.65, 3.22),
-    (2.83, 3.44),
-    (2.98, 3.67),
-    (3.11, 3.89),
-    (3.33, 4.11),
-];
-
-/// Martin & Moyce (1952) residual column height `H = h / (2a)` at `τ = t √(g/a)` (spec §6 S2).
-pub const MARTIN_MOYCE_HEIGHT: [(f64, f64); 17] = [
-    (0.56, 0.94),
-    (0.77, 0.89),
-    (0.93, 0.83),
-    (1.08, 0.78),
-    (1.28, 0.72),
-    (1.46, 0.67),
-    (1.66, 0.61),
-    (1.84, 0.56),
-    (2.00, 0.50),
-    (2.21, 0.44),
-    (2.45, 0.39),
-    (2.70, 0.33),
-    (3.06, 0.28),
-    (3.44, 0.22),
-    (4.20, 0.17),
-    (5.25, 0.11),
-    (7.40, 0.06),
-];
-
 /// Front position `max_p (x_p + r_p)` along x over non-ballistic particles, measured from `wall`
 /// (m); 0 without particles.
 pub fn front_position(parts: &Particles, wall: f64) -> f64 {
-    (0..parts.len()).filter(|&i| !parts.is_ballistic(i)).map(|i| parts.x[i].x + parts.r[i] - wall).fold(0.0, f64::max)
+    (0..parts.len())
+        .filter(|&i| !parts.is_ballistic(i))
+        .map(|i| parts.x[i].x + parts.r[i] - wall)
+        .fold(0.0, stats::nan_max)
 }
 
 /// Residual column height `max_{x_p − wall < width} (y_p + r_p) − floor` (m).
@@ -58,7 +26,7 @@ pub fn column_height(p: &Particles, wall: f64, width: f64, floor: f64) -> f64 {
     (0..p.len())
         .filter(|&i| !p.is_ballistic(i) && p.x[i].x - wall < width)
         .map(|i| p.x[i].y + p.r[i] - floor)
-        .fold(0.0, f64::max)
+        .fold(0.0, stats::nan_max)
 }
 
 /// Surface height at `(x, z)`: the highest `y` where the linear interpolant of the node level set
@@ -168,14 +136,9 @@ pub fn damping_ratio(series: &[(f64, f64)], t_skip: f64) -> Option<f64> {
     if amps.len() < 3 || amps.iter().any(|&a| a <= 0.0) {
         return None;
     }
-    let n = amps.len() as f64;
-    let (sx, sy) = (0..amps.len()).fold((0.0, 0.0), |(sx, sy), k| (sx + k as f64, sy + amps[k].ln()));
-    let (mx, my) = (sx / n, sy / n);
-    let (sxy, sxx) = (0..amps.len()).fold((0.0, 0.0), |(sxy, sxx), k| {
-        let dx = k as f64 - mx;
-        (sxy + dx * (amps[k].ln() - my), sxx + dx * dx)
-    });
-    let delta = -2.0 * sxy / sxx;
+    let pts: Vec<(f64, f64)> = amps.iter().enumerate().map(|(k, a)| (k as f64, a.ln())).collect();
+    let (_, slope, _) = stats::linear_fit(&pts);
+    let delta = -2.0 * slope;
     Some(delta / (4.0 * std::f64::consts::PI.powi(2) + delta * delta).sqrt())
 }
 
@@ -265,6 +228,204 @@ pub fn csv_row(s: &StepStats) -> Vec<f64> {
     ]
 }
 
+/// Largest relative deviation `max_k |f(s_k) − f(s_0)| / |f(s_0)|` of a per-step quantity from
+/// its first value (0 for no steps; NaN if any value is NaN).
+pub fn rel_drift(stats: &[StepStats], f: impl Fn(&StepStats) -> f64) -> f64 {
+    let Some(first) = stats.first() else { return 0.0 };
+    let v0 = f(first);
+    stats.iter().map(|x| (f(x) - v0).abs()).fold(0.0, stats::nan_max) / v0.abs().max(1e-300)
+}
+
+/// Largest particle speed over the steps (m/s; 0 for no steps, NaN if any is NaN).
+pub fn max_speed(stats: &[StepStats]) -> f64 {
+    stats.iter().map(|x| x.max_speed).fold(0.0, stats::nan_max)
+}
+
+/// Relative errors `(Z_sim(T) − Z_ref)/Z_ref` of a simulated series `(T, Z)` (sorted by `T`)
+/// against the reference points `(T, Z_ref)` with `T − shift` inside the simulated range, the
+/// simulation read at `T − shift` (a positive `shift` delays the simulation), and their RMS
+/// (NaN without a compared point).
+pub fn series_rel_errors(sim: &[(f64, f64)], reference: &[(f64, f64)], shift: f64) -> (Vec<f64>, f64) {
+    let t_end = sim.last().map_or(0.0, |x| x.0);
+    let errs: Vec<f64> =
+        reference.iter().filter(|x| x.0 - shift <= t_end).map(|&(t, z)| (interp(sim, t - shift) - z) / z).collect();
+    let rms = if errs.is_empty() { f64::NAN } else { stats::rms(&errs) };
+    (errs, rms)
+}
+
+/// Relative front errors `(Z_sim − Z_exp)/Z_exp` at the tabulated reference times covered by the
+/// simulated series `(T, Z)`, and their RMS (spec §6 S2, no time shift).
+pub fn front_errors(front: &[(f64, f64)], reference: &[(f64, f64)]) -> (Vec<f64>, f64) {
+    let t_end = front.last().map_or(0.0, |x| x.0);
+    let errs: Vec<f64> = reference.iter().filter(|x| x.0 <= t_end).map(|&(t, z)| (interp(front, t) - z) / z).collect();
+    let rms = (errs.iter().map(|e| e * e).sum::<f64>() / errs.len().max(1) as f64).sqrt();
+    (errs, rms)
+}
+
+/// The time shift `δ ∈ [0, max]` (step `step`) minimising the RMS of `Z_sim(T − δ)` against the
+/// reference, and that RMS (see [`fit_time_shift`]).
+pub fn best_time_shift(sim: &[(f64, f64)], reference: &[(f64, f64)], max: f64, step: f64) -> (f64, f64) {
+    fit_time_shift(sim, reference, 0.0, max, step)
+}
+
+/// One fitted time origin: the shift `δ ∈ [lo, hi]` (searched on the grid `lo + k · step`)
+/// minimising the RMS relative error of `Z_sim(T − δ)` against the reference points `(T, Z_ref)`
+/// with `T` inside the simulated range, and that RMS. A positive `δ` means the simulation leads
+/// (it is delayed by `δ` to match). The simulated series is read by linear interpolation,
+/// clamped at its ends. Ties keep the smaller shift; `(NaN, NaN)` without a compared point or
+/// with NaN errors only.
+pub fn fit_time_shift(sim: &[(f64, f64)], reference: &[(f64, f64)], lo: f64, hi: f64, step: f64) -> (f64, f64) {
+    let n = ((hi - lo) / step).round() as usize;
+    let t_end = sim.last().map_or(0.0, |f| f.0);
+    let pts: Vec<(f64, f64)> = reference.iter().copied().filter(|x| x.0 <= t_end).collect();
+    if pts.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let mut best = (f64::NAN, f64::INFINITY);
+    for k in 0..=n {
+        let d = lo + step * k as f64;
+        let e: Vec<f64> = pts.iter().map(|&(t, z)| (interp(sim, t - d) - z) / z).collect();
+        let rms = (e.iter().map(|v| v * v).sum::<f64>() / e.len() as f64).sqrt();
+        if rms < best.1 {
+            best = (d, rms);
+        }
+    }
+    if best.1.is_infinite() {
+        (f64::NAN, f64::NAN)
+    } else {
+        best
+    }
+}
+
+/// Largest `|H_sim(τ) − H_ref(τ)|` over the reference points with `τ ≤ tau_max` (and inside the
+/// simulated range); 0 without a point, NaN if a difference is NaN.
+pub fn height_max_abs_err(sim: &[(f64, f64)], reference: &[(f64, f64)], tau_max: f64) -> f64 {
+    let tau_end = sim.last().map_or(0.0, |x| x.0);
+    reference
+        .iter()
+        .filter(|x| x.0 <= tau_end.min(tau_max))
+        .map(|&(tau, h)| (interp(sim, tau) - h).abs())
+        .fold(0.0, stats::nan_max)
+}
+
+/// Pearson correlation of two equally long samples (NaN when either has no spread).
+pub fn pearson(xs: &[f64], ys: &[f64]) -> f64 {
+    let n = xs.len().max(1) as f64;
+    let (mx, my) = (xs.iter().sum::<f64>() / n, ys.iter().sum::<f64>() / n);
+    let cov: f64 = xs.iter().zip(ys).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let (vx, vy) = (xs.iter().map(|a| (a - mx).powi(2)).sum::<f64>(), ys.iter().map(|b| (b - my).powi(2)).sum::<f64>());
+    if vx > 0.0 && vy > 0.0 {
+        cov / (vx * vy).sqrt()
+    } else {
+        f64::NAN
+    }
+}
+
+/// The figures every simulation scene reports about its run (issue 5): `wall_s`, `steps`,
+/// `particles_avg`, `us_per_particle_step`, the five stage times `time_{remesh,transfer,solve,
+/// advect,surface}_s`, the phases inside them `phase_*_s` and the build `profile`.
+pub fn run_figures(r: &mut Report, stats: &[StepStats], wall: f64) {
+    let steps = stats.len().max(1) as f64;
+    let psteps: f64 = stats.iter().map(|x| x.n_particles as f64).sum();
+    r.timing("wall_s", wall);
+    r.count("steps", stats.len() as u64);
+    r.num("particles_avg", psteps / steps);
+    r.timing("us_per_particle_step", 1e6 * wall / psteps.max(1.0));
+    let mut st = [0.0; 5];
+    for x in stats {
+        for (a, b) in st.iter_mut().zip(x.timings.stages()) {
+            *a += b;
+        }
+    }
+    for (k, v) in ["remesh", "transfer", "solve", "advect", "surface"].iter().zip(st) {
+        r.timing(&format!("time_{k}_s"), v);
+    }
+    let phase = |f: fn(&crate::sim::PhaseTimings) -> f64| stats.iter().map(|x| f(&x.timings)).sum::<f64>();
+    r.timing("phase_p2g_s", phase(|t| t.p2g));
+    r.timing("phase_extrapolate_s", phase(|t| t.extrapolate));
+    r.timing("phase_g2p_s", phase(|t| t.g2p));
+    r.timing("phase_assemble_s", phase(|t| t.assemble));
+    r.timing("phase_linear_solve_s", phase(|t| t.solve));
+    r.timing("phase_advect_s", phase(|t| t.advect));
+    r.timing("phase_correction_s", phase(|t| t.correction));
+    r.timing("phase_ballistic_s", phase(|t| t.ballistic));
+    r.text("profile", profile());
+}
+
+/// `"debug"` or `"release"`: the build profile the figures were measured with.
+pub fn profile() -> &'static str {
+    if cfg!(debug_assertions) {
+        "debug"
+    } else {
+        "release"
+    }
+}
+
+/// Particle volume (m³, `Σ 8 r³`) below height `y`.
+pub fn volume_below(parts: &Particles, y: f64) -> f64 {
+    (0..parts.len()).filter(|&i| parts.x[i].y < y).map(|i| parts.volume(i)).sum()
+}
+
+/// Liquid volume of the scene's initial shapes (outside the obstacles) estimated by sampling the
+/// centres of an `n × n × n` grid over the domain (m³).
+pub fn sampled_liquid_volume(scene: &crate::scene::Scene, n: usize) -> f64 {
+    let (mn, mx) = (scene.min(), scene.max());
+    let d = (mx - mn) / n as f64;
+    let mut c = 0usize;
+    for i in 0..n {
+        for j in 0..n {
+            for k in 0..n {
+                let x = mn
+                    + geom_core::math::Vec3::new(
+                        (i as f64 + 0.5) * d.x,
+                        (j as f64 + 0.5) * d.y,
+                        (k as f64 + 0.5) * d.z,
+                    );
+                if scene.liquid_sdf(&x) < 0.0 && scene.solid_sdf(&x) > 0.0 {
+                    c += 1;
+                }
+            }
+        }
+    }
+    c as f64 * d.x * d.y * d.z
+}
+
+/// Top of the liquid body: the largest `y + r` over the non-ballistic particles (m; NaN without
+/// one).
+pub fn liquid_top(p: &Particles) -> f64 {
+    (0..p.len()).filter(|&i| !p.is_ballistic(i)).map(|i| p.x[i].y + p.r[i]).fold(f64::NAN, |a, b| {
+        if a.is_nan() {
+            b
+        } else {
+            stats::nan_max(a, b)
+        }
+    })
+}
+
+/// The rest state of the particles' liquid in the scene's box (spec §6 S10): the particle volume
+/// `V = Σ (2r)³` spread flat over the domain floor `A` (obstacles ignored) has the surface height
+/// `h = y_floor + V / A` and the potential energy `ρ g V (y_floor + (h − y_floor) / 2)` (J, the
+/// convention of `StepStats::potential_energy`). Returns `(energy J, h m)`.
+pub fn rest_potential_energy(scene: &crate::scene::Scene, p: &Particles) -> (f64, f64) {
+    let v = p.total_volume();
+    let area = (scene.domain.max[0] - scene.domain.min[0]) * (scene.domain.max[2] - scene.domain.min[2]);
+    let floor = scene.domain.min[1];
+    let depth = v / area;
+    let g = -scene.gravity[1];
+    (crate::sim::RHO * g * v * (floor + 0.5 * depth), floor + depth)
+}
+
+/// Splash height above the rest surface `h_rest` (m) from the liquid-top series `(t, top)`: the
+/// largest top after the time the top was lowest (the falling liquid has merged with the pool),
+/// minus `h_rest`. NaN for an empty series or NaN tops.
+pub fn splash_height(tops: &[(f64, f64)], h_rest: f64) -> f64 {
+    if tops.is_empty() || tops.iter().any(|x| x.1.is_nan()) {
+        return f64::NAN;
+    }
+    let k = (0..tops.len()).fold(0, |b, i| if tops[i].1 < tops[b].1 { i } else { b });
+    tops[k..].iter().map(|x| x.1).fold(f64::NEG_INFINITY, f64::max) - h_rest
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -275,7 +436,7 @@ mod tests {
             (0..2000).map(|i| i as f64 * 0.002).map(|t| (t, 0.3 + 0.02 * (5.0 * t).cos())).collect();
         let p = zero_crossing_period(&s, 0.1).unwrap();
         assert!((p - 2.0 * std::f64::consts::PI / 5.0).abs() < 1e-3);
-        assert!((interp(&MARTIN_MOYCE_FRONT, 0.41) - 1.11).abs() < 1e-15);
+        assert!((interp(&crate::reference::MARTIN_MOYCE_FRONT, 0.41) - 1.11).abs() < 1e-15);
         assert_eq!(csv_row(&StepStats::default()).len(), CSV_HEADER.len());
     }
 

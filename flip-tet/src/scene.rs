@@ -349,6 +349,33 @@ fn fps() -> f64 {
 }
 
 impl Scene {
+    /// A scene over `domain` (min, max corners, m) at `resolution` (coarsest, finest cubes along
+    /// the longest axis) holding `liquid`, every other field at its default (the values a scene
+    /// file gets when it leaves them out).
+    pub fn new(domain: ([f64; 3], [f64; 3]), resolution: (u32, u32), liquid: Vec<Shape>) -> Self {
+        Self {
+            name: String::new(),
+            domain: DomainBox { min: domain.0, max: domain.1 },
+            resolution: Resolution { coarsest: resolution.0, finest: resolution.1 },
+            duration: one(),
+            fps: fps(),
+            seed: 0,
+            gravity: default_gravity(),
+            liquid,
+            initial_velocity: [0.0; 3],
+            moving_liquid: Vec::new(),
+            obstacles: Vec::new(),
+            open_faces: Vec::new(),
+            extra_grading_layers: 0,
+            sizing: SizingParams::default(),
+            particles: ParticleParams::default(),
+            flip: FlipParams::default(),
+            pressure: PressureParams::default(),
+            transfer: TransferParams::default(),
+            surface: SurfaceParams::default(),
+        }
+    }
+
     /// Domain minimum corner.
     pub fn min(&self) -> Pt3 {
         p3(&self.domain.min)

@@ -147,6 +147,9 @@ pub struct FlipTetSim {
     tet_u: Vec<Vec3>,
     solver: PressureSolver,
     warm: Option<(Vec<u32>, Vec<f64>)>,
+    /// Gauge pressure of the last projection at the mesh nodes (Pa; 0 at air and solid nodes):
+    /// `p = ρ q / Δt_kick` from the solve's `q = Δt_kick p / ρ`.
+    pressure: Vec<f64>,
     step: u64,
     time: f64,
     frame: u64,
@@ -436,6 +439,7 @@ impl FlipTetSim {
             tet_u: Vec::new(),
             solver: PressureSolver::default(),
             warm: None,
+            pressure: Vec::new(),
             step: 0,
             time: 0.0,
             frame: 0,
@@ -470,6 +474,7 @@ impl FlipTetSim {
         self.h_tet = mesh.tet_level.iter().map(|&l| self.spec.h(l)).collect();
         self.nodal_u = vec![Vec3::zeros(); mesh.nodes.len()];
         self.tet_u = vec![Vec3::zeros(); mesh.tets.len()];
+        self.pressure = vec![0.0; mesh.nodes.len()];
         // Same rows as `surface::node_edges` (tested in tests/mesh.rs), cached by the mesh.
         self.edges = mesh.node_nbrs.clone();
         self.mesh = mesh;
@@ -821,6 +826,11 @@ impl FlipTetSim {
             return Err(SimError::NonFinite { what: "pressure", step: self.step });
         }
         let updated = apply_pressure(&self.mesh, &sys, &q, &mut u);
+        let mut pressure = vec![0.0; self.mesh.nodes.len()];
+        for (d, &node) in sys.node_of_dof.iter().enumerate() {
+            pressure[node as usize] = RHO * q[d] / dt_kick;
+        }
+        self.pressure = pressure;
         self.warm = Some((sys.node_of_dof.clone(), q));
         tm.apply = c.elapsed().as_secs_f64();
         st.n_dofs = sys.rhs.len();
@@ -981,6 +991,23 @@ impl FlipTetSim {
         }
         let (t, l) = self.mesh.locate(&self.octree, x)?;
         Some(sample(&self.mesh, &self.tet_u, &self.nodal_u, t, &l))
+    }
+
+    /// Gauge pressure of the last projection at the mesh nodes (Pa; 0 at air and solid nodes).
+    pub fn node_pressure(&self) -> &[f64] {
+        &self.pressure
+    }
+
+    /// Gauge pressure of the last projection at `x` (Pa): the P1 interpolant of the node
+    /// pressures in the tet holding `x` (exact for hydrostatics `p = ρ g (H − y)` below the first
+    /// node layer under the surface); `None` outside the mesh or before the first step.
+    pub fn pressure_at(&self, x: &Pt3) -> Option<f64> {
+        if self.pressure.len() != self.mesh.nodes.len() || self.step == 0 {
+            return None;
+        }
+        let (t, l) = self.mesh.locate(&self.octree, x)?;
+        let tv = self.mesh.tets[t as usize];
+        Some((0..4).map(|a| l[a] * self.pressure[tv[a] as usize]).sum())
     }
 
     /// Particles.

@@ -36,6 +36,11 @@ pub struct SizingParams {
     pub depth_floor: Option<f64>,
     /// Surface band width in finest cubes (`B = r_min` within it); `None` = off.
     pub surface_band: Option<f64>,
+    /// Solid-proximity band width in finest cubes (ours, issue 26): liquid within this distance of
+    /// an obstacle (`solid SDF < w h_min`) asks for `r_min`, overriding the depth floor like the
+    /// surface band. The spec's solid-curvature metric leaves flat obstacle faces coarse, where
+    /// liquid converging into holes then runs on coarse cells (S7); `None` = off.
+    pub solid_proximity: Option<f64>,
     /// User boxes with radii; `None` = off.
     pub user: Option<Vec<UserBox>>,
     /// Temporal smoothing (spec §3.12, optional): at a remesh a particle's demanded radius is
@@ -53,6 +58,7 @@ impl Default for SizingParams {
             visibility: None,
             depth_floor: Some(0.25),
             surface_band: None,
+            solid_proximity: None,
             user: None,
             temporal_smoothing: false,
         }
@@ -76,6 +82,9 @@ impl SizingParams {
         }
         if !pos(self.surface_band) {
             return bad("surface_band must be finite and > 0");
+        }
+        if !pos(self.solid_proximity) {
+            return bad("solid_proximity must be finite and > 0");
         }
         if !self.depth_floor.is_none_or(|g| g >= 0.0 && g.is_finite()) {
             return bad("depth_floor must be finite and >= 0");
@@ -160,6 +169,8 @@ pub struct Sizing {
     pub depth_floor: Option<f64>,
     /// Surface band width in finest cubes.
     pub surface_band: Option<f64>,
+    /// Solid-proximity band width in finest cubes ([`SizingParams::solid_proximity`]).
+    pub solid_proximity: Option<f64>,
 }
 
 impl std::fmt::Debug for Sizing {
@@ -190,7 +201,13 @@ impl Sizing {
         if let Some(b) = &p.user {
             metrics.push(Box::new(UserBoxes { boxes: b.clone() }));
         }
-        Ok(Self { metrics, visibility: p.visibility.clone(), depth_floor: p.depth_floor, surface_band: p.surface_band })
+        Ok(Self {
+            metrics,
+            visibility: p.visibility.clone(),
+            depth_floor: p.depth_floor,
+            surface_band: p.surface_band,
+            solid_proximity: p.solid_proximity,
+        })
     }
 
     /// Whether an obstacle metric ([`SizingMetric::is_obstacle_metric`]) is on.
@@ -260,7 +277,11 @@ impl Sizing {
             (Some(w), Some(p)) if p > -w * ctx.h_min => ctx.r_min,
             _ => f64::INFINITY,
         };
-        let s = b.min(d.max(v));
+        let near_solid = match (self.solid_proximity, ctx.solid_sdf) {
+            (Some(w), Some(f)) if f(x) < w * ctx.h_min => ctx.r_min,
+            _ => f64::INFINITY,
+        };
+        let s = b.min(near_solid).min(d.max(v));
         if s.is_finite() {
             s.clamp(ctx.r_min, ctx.r_max)
         } else {

@@ -66,6 +66,15 @@ pub enum Error {
     /// An out-of-range or inconsistent parameter; the string says which and why.
     #[error("invalid parameter: {0}")]
     InvalidParameter(String),
+    /// An error found while reading a file, with the file's path (the inner error says what is
+    /// wrong and where inside the file).
+    #[error("{}: {source}", path.display())]
+    InFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong with it.
+        source: Box<Error>,
+    },
 }
 
 /// The specific ways a BVH file can be malformed (motion-graph.md §2.2, §7.1). Each carries the

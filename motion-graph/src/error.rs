@@ -9,6 +9,14 @@ pub enum Error {
     /// geom-core error (BVH parsing, mesh building, …).
     #[error(transparent)]
     Core(#[from] geom_core::Error),
+    /// A motion file could not be read.
+    #[error("{path}: {source}")]
+    File {
+        /// The file.
+        path: String,
+        /// What went wrong.
+        source: geom_core::Error,
+    },
     /// The database has no usable clip (none given, or every clip shorter than 3 frames).
     #[error("empty database: {0}")]
     EmptyDatabase(String),

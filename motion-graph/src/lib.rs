@@ -7,7 +7,8 @@
 //! threshold τ §3.3, hierarchy of graphs by edge clustering §3.4) → [`Search`] (randomized search
 //! over paths §3.5–3.8 for a [`Problem`] of soft and hard constraints) → [`assemble`], [`smooth`]
 //! (±W frames around each cut, §3.10) and [`enforce_body`] (exact body constraints, §3.11) →
-//! [`evaluate`] (§3.12 metrics).
+//! [`evaluate`] (§3.12 metrics). [`experiments::search`] runs a whole scene (MG-1 … MG-8) and
+//! [`metrics`] turns its results into the figures of `summary.json`.
 //!
 //! Conventions: metres, seconds, radians inside (degrees in scene files); +Y up, characters
 //! face +Z; frames at the database rate (default 30 Hz).
@@ -16,10 +17,12 @@ pub mod assemble;
 pub mod db;
 pub mod error;
 pub(crate) mod eval;
+pub mod experiments;
 pub mod features;
 pub mod graph;
 pub mod guided;
 pub mod kmeans;
+pub mod metrics;
 pub mod path;
 pub mod problem;
 pub mod rigid;

@@ -423,9 +423,46 @@ impl Ord for Entry {
     }
 }
 
+/// Limits of the discrete search (issue 23: the search must return in bounded time).
+///
+/// When a limit is hit before `k` complete embeddings were popped, the search completes the
+/// most promising partial embeddings depth first (cheapest increment first, with backtracking)
+/// and returns the best complete embedding found, flagged `certified_optimal = false`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SearchBudget {
+    /// Partial embeddings expanded by the best-first search at most (deterministic).
+    pub max_expansions: usize,
+    /// Wall-clock limit of the best-first search (s); `None` = none. A time limit makes the
+    /// result depend on the machine when it is hit; the expansion limit does not.
+    pub max_seconds: Option<f64>,
+    /// Node visits of the depth-first completion after a limit was hit.
+    pub completion_visits: usize,
+}
+
+impl SearchBudget {
+    /// The budget of a rig's options (`max_expansions`, `max_search_seconds`).
+    pub fn of(o: &RigOptions) -> Self {
+        SearchBudget {
+            max_expansions: o.max_expansions,
+            max_seconds: o.max_search_seconds,
+            completion_visits: (o.max_expansions / 4).max(1000),
+        }
+    }
+}
+
 /// The `k` best complete embeddings in non-decreasing penalty order (the first is optimal when
-/// `certified_optimal`). Best-first branch and bound (spec §3.8).
+/// `certified_optimal`), within the budget of the options ([`search`]). Best-first branch and
+/// bound (spec §3.8).
 pub fn k_best_embeddings(pr: &Problem, k: usize) -> Result<Vec<DiscreteEmbedding>> {
+    search(pr, k, &SearchBudget::of(pr.o))
+}
+
+/// Best-first branch and bound (spec §3.8) for the `k` best embeddings, within `budget`. Every
+/// returned embedding records the expansions spent. If the budget stops the search first, the
+/// embeddings found so far are returned, or, if none, the best completion of the open partial
+/// embeddings (`certified_optimal = false`); `NoEmbedding` when nothing passes the bound.
+pub fn search(pr: &Problem, k: usize, budget: &SearchBudget) -> Result<Vec<DiscreteEmbedding>> {
+    let t0 = std::time::Instant::now();
     let rs = pr.rs;
     let r = rs.len();
     let mut heap = BinaryHeap::new();
@@ -434,6 +471,7 @@ pub fn k_best_embeddings(pr: &Problem, k: usize) -> Result<Vec<DiscreteEmbedding
     let mut expanded = 0usize;
     let mut maxq = 1usize;
     let mut certified = true;
+    let mut stopped = false;
     let mut deepest: Vec<u32> = Vec::new();
     while let Some(e) = heap.pop() {
         if e.verts.len() == r {
@@ -450,30 +488,17 @@ pub fn k_best_embeddings(pr: &Problem, k: usize) -> Result<Vec<DiscreteEmbedding
             }
             continue;
         }
+        if expanded >= budget.max_expansions || budget.max_seconds.is_some_and(|s| t0.elapsed().as_secs_f64() > s) {
+            heap.push(e);
+            stopped = true;
+            break;
+        }
         expanded += 1;
         if e.verts.len() > deepest.len() {
             deepest = e.verts.clone();
         }
-        let i = e.verts.len();
-        let used = if i > 0 { pr.used(&e.verts) } else { vec![false; pr.g.len()] };
-        for &v in &pr.cand[i] {
-            let Some(b) = pr.increment(&e.verts, &used, v) else { continue };
-            let inc = pr.weighted(&b);
-            let g = e.g + inc;
-            if g > pr.o.reject_bound {
-                continue;
-            }
-            let mut verts = e.verts.clone();
-            verts.push(v);
-            let lb = g + pr.completion_bound(&verts);
-            if !(lb <= pr.o.reject_bound) {
-                continue;
-            }
-            let mut feat = e.feat;
-            for q in 0..9 {
-                feat[q] += b[q];
-            }
-            heap.push(Entry { lb, g, feat, verts });
+        for child in expand(pr, &e) {
+            heap.push(child);
         }
         maxq = maxq.max(heap.len());
         if heap.len() > pr.o.max_queue {
@@ -485,10 +510,90 @@ pub fn k_best_embeddings(pr: &Problem, k: usize) -> Result<Vec<DiscreteEmbedding
             heap = v.into_iter().collect();
         }
     }
+    if stopped && out.is_empty() {
+        // Complete the most promising open partials depth first; keep the cheapest result.
+        let mut visits = 0usize;
+        let mut best: Option<Entry> = None;
+        while let Some(e) = heap.pop() {
+            if visits >= budget.completion_visits {
+                break;
+            }
+            if best.as_ref().is_some_and(|b| b.g <= e.lb) {
+                break;
+            }
+            if let Some(c) = complete(pr, e, &mut visits, budget.completion_visits) {
+                if best.as_ref().is_none_or(|b| c.g < b.g) {
+                    best = Some(c);
+                }
+            }
+        }
+        if let Some(b) = best {
+            out.push(DiscreteEmbedding {
+                verts: b.verts,
+                penalty: b.g,
+                features: b.feat,
+                certified_optimal: false,
+                expanded,
+                max_queue: maxq,
+            });
+        }
+    }
     if out.is_empty() {
-        return Err(RigError::NoEmbedding { best_partial: if deepest.is_empty() { None } else { Some(deepest) } });
+        return Err(RigError::NoEmbedding {
+            best_partial: if deepest.is_empty() { None } else { Some(deepest) },
+            expanded,
+        });
     }
     Ok(out)
+}
+
+/// The children of a partial embedding that pass the rejection rules (spec §3.7–3.8).
+fn expand(pr: &Problem, e: &Entry) -> Vec<Entry> {
+    let i = e.verts.len();
+    let used = if i > 0 { pr.used(&e.verts) } else { vec![false; pr.g.len()] };
+    let mut out = Vec::new();
+    for &v in &pr.cand[i] {
+        let Some(b) = pr.increment(&e.verts, &used, v) else { continue };
+        let g = e.g + pr.weighted(&b);
+        if g > pr.o.reject_bound {
+            continue;
+        }
+        let mut verts = e.verts.clone();
+        verts.push(v);
+        let lb = g + pr.completion_bound(&verts);
+        if !(lb <= pr.o.reject_bound) {
+            continue;
+        }
+        let mut feat = e.feat;
+        for q in 0..9 {
+            feat[q] += b[q];
+        }
+        out.push(Entry { lb, g, feat, verts });
+    }
+    out
+}
+
+/// Depth-first completion of `e`, children in increasing bound order, until a complete
+/// embedding is found or `max_visits` nodes were visited in all.
+fn complete(pr: &Problem, e: Entry, visits: &mut usize, max_visits: usize) -> Option<Entry> {
+    if e.verts.len() == pr.rs.len() {
+        return Some(e);
+    }
+    if *visits >= max_visits {
+        return None;
+    }
+    *visits += 1;
+    let mut children = expand(pr, &e);
+    children.sort_by(|a, b| a.lb.total_cmp(&b.lb).then(a.verts.cmp(&b.verts)));
+    for c in children {
+        if let Some(done) = complete(pr, c, visits, max_visits) {
+            return Some(done);
+        }
+        if *visits >= max_visits {
+            break;
+        }
+    }
+    None
 }
 
 /// The optimal discrete embedding (spec §3.8).

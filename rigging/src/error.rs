@@ -41,10 +41,14 @@ pub enum RigError {
         components: usize,
     },
     /// The discrete search found no embedding below the rejection bound.
-    #[error("no skeleton embedding passes the penalty bound (best partial: {best_partial:?})")]
+    #[error(
+        "no skeleton embedding passes the penalty bound after {expanded} expanded partial embeddings (best partial: {best_partial:?})"
+    )]
     NoEmbedding {
         /// Graph vertices of the deepest partial embedding seen, if any.
         best_partial: Option<Vec<u32>>,
+        /// Partial embeddings the search expanded before giving up.
+        expanded: usize,
     },
     /// The bone-heat solve failed.
     #[error("bone heat solve failed: {0}")]

@@ -39,6 +39,13 @@ pub struct RigOptions {
     pub reject_bound: f64,
     /// Best-first queue cap before falling back to a bounded (uncertified) queue.
     pub max_queue: usize,
+    /// Partial embeddings the best-first search may expand before it returns the best
+    /// embedding found (`certified_optimal = false`); bounds the time of the discrete stage
+    /// (about 0.2 ms per expansion on this machine, release build).
+    pub max_expansions: usize,
+    /// Wall-clock limit (s) of the discrete search, `None` = none (results then depend on the
+    /// machine when the limit is hit; the expansion limit does not).
+    pub max_search_seconds: Option<f64>,
     /// Outer refinement iterations. Paper: 10.
     pub refine_iters: usize,
     /// Refinement weights (α_S, α_L, α_O, α_A).
@@ -77,6 +84,8 @@ impl Default for RigOptions {
             gamma: GAMMA_PUBLISHED,
             reject_bound: 1.0,
             max_queue: 2_000_000,
+            max_expansions: 50_000,
+            max_search_seconds: None,
             refine_iters: 10,
             refine_alpha: [15000.0, 0.25, 2.0, 1.0],
             heat_c: 1.0,
@@ -106,6 +115,9 @@ impl RigOptions {
         }
         if !(self.skeleton_scale > 0.0) || !(self.heat_c > 0.0) || !(self.d_floor > 0.0) {
             return bad("skeleton_scale, heat_c and d_floor must be positive");
+        }
+        if self.max_expansions == 0 || self.max_search_seconds.is_some_and(|s| !(s > 0.0)) {
+            return bad("max_expansions must be ≥ 1 and max_search_seconds positive");
         }
         if self.gamma.iter().any(|g| !(*g >= 0.0 && g.is_finite())) {
             return bad("gamma must be finite and non-negative");

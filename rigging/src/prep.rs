@@ -28,6 +28,79 @@ pub struct PrepReport {
     pub flipped_faces: usize,
     /// Components discarded (only with `keep_largest_component`).
     pub dropped_components: usize,
+    /// Non-manifold vertices (several fans of faces meeting at one point) split into one vertex
+    /// per fan.
+    pub split_vertices: usize,
+    /// Input vertex → vertex of the prepared mesh (`u32::MAX` for a vertex dropped with a
+    /// discarded component). A split vertex maps to its first copy.
+    pub vertex_map: Vec<u32>,
+}
+
+/// Splits every non-manifold vertex — one where the faces around it form several fans (groups
+/// connected through edges at that vertex), e.g. two cones touching at their tips — into one
+/// vertex per fan; the copies are appended after the existing vertices. Returns the number of
+/// vertices split. Assumes every edge has at most two faces.
+pub fn split_nonmanifold_vertices(positions: &mut Vec<Pt3>, faces: &mut [[u32; 3]]) -> usize {
+    let n = positions.len();
+    let mut around: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for (f, t) in faces.iter().enumerate() {
+        for &v in t {
+            around[v as usize].push(f as u32);
+        }
+    }
+    let mut split = 0;
+    for v in 0..n {
+        let fs = &around[v];
+        if fs.len() < 2 {
+            continue;
+        }
+        // Union-find over the faces at v, joined when they share an edge (v, w).
+        let mut parent: Vec<usize> = (0..fs.len()).collect();
+        fn find(p: &mut [usize], mut x: usize) -> usize {
+            while p[x] != x {
+                p[x] = p[p[x]];
+                x = p[x];
+            }
+            x
+        }
+        let mut by_other: HashMap<u32, usize> = HashMap::new();
+        for (k, &f) in fs.iter().enumerate() {
+            for &w in &faces[f as usize] {
+                if w as usize == v {
+                    continue;
+                }
+                if let Some(&k2) = by_other.get(&w) {
+                    let (a, b) = (find(&mut parent, k), find(&mut parent, k2));
+                    parent[a.max(b)] = a.min(b);
+                } else {
+                    by_other.insert(w, k);
+                }
+            }
+        }
+        let roots: Vec<usize> = (0..fs.len()).map(|k| find(&mut parent, k)).collect();
+        let mut fans: Vec<usize> = roots.clone();
+        fans.sort_unstable();
+        fans.dedup();
+        if fans.len() < 2 {
+            continue;
+        }
+        split += 1;
+        // The fan of the lowest face keeps v; every other fan gets a copy.
+        for &fan in &fans[1..] {
+            let copy = positions.len() as u32;
+            positions.push(positions[v]);
+            for (k, &f) in fs.iter().enumerate() {
+                if roots[k] == fan {
+                    for x in faces[f as usize].iter_mut() {
+                        if *x as usize == v {
+                            *x = copy;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    split
 }
 
 /// Welds, checks and orients a raw triangle soup into a closed, connected, outward-oriented
@@ -45,8 +118,8 @@ pub fn prepare(positions: &[Pt3], faces: &[[u32; 3]], keep_largest_component: bo
     }
     // Weld first: unwelded duplicates would otherwise look like holes.
     let diag = geom_core::spatial::Aabb::from_points(positions).diag();
-    let (wp, wf, _) = geom_core::mesh::weld(positions, faces, 1e-9 * diag);
-    let mut rep = PrepReport { welded_vertices: positions.len() - wp.len(), ..Default::default() };
+    let (mut wp, mut wf, map) = geom_core::mesh::weld(positions, faces, 1e-9 * diag);
+    let mut rep = PrepReport { welded_vertices: positions.len() - wp.len(), vertex_map: map, ..Default::default() };
     let collapsed = faces.len() - wf.len();
     // Edge use counts (undirected) on the welded soup, ignoring exact duplicate faces.
     let mut seen = std::collections::HashSet::new();
@@ -81,6 +154,9 @@ pub fn prepare(positions: &[Pt3], faces: &[[u32; 3]], keep_largest_component: bo
             example: boundary.into_iter().take(8).collect(),
         });
     }
+    // A non-manifold vertex (two fans touching at a point) is split into one vertex per fan:
+    // the surface stays closed and each fan becomes a proper disc.
+    rep.split_vertices = split_nonmanifold_vertices(&mut wp, &mut wf);
     let o = RepairOptions { weld_rel: None, drop_degenerate: true, drop_duplicates: true, orient: true, outward: true };
     let (mut m, r) = TriMesh::repair(wp, wf, &o)?;
     rep.dropped_degenerate = collapsed + r.dropped_degenerate;
@@ -121,6 +197,9 @@ pub fn prepare(positions: &[Pt3], faces: &[[u32; 3]], keep_largest_component: bo
             .collect();
         m = TriMesh::new(pos, faces)?;
         rep.dropped_components = nc - 1;
+        for x in rep.vertex_map.iter_mut() {
+            *x = remap.get(*x as usize).copied().unwrap_or(u32::MAX);
+        }
     }
     let vol = geom_core::mesh::signed_volume(&m.faces, &m.positions);
     if !(vol > 0.0) {

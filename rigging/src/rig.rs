@@ -183,7 +183,7 @@ pub fn autorig(
     let pr = Problem::new(&graph, sk, &rs, &cand, o);
     let discrete = match k_best_embeddings(&pr, 1) {
         Ok(mut v) => v.remove(0),
-        Err(RigError::NoEmbedding { best_partial }) if graph.components > 1 && best_partial.is_none() => {
+        Err(RigError::NoEmbedding { best_partial, .. }) if graph.components > 1 && best_partial.is_none() => {
             return Err(RigError::GraphDisconnected { components: graph.components })
         }
         Err(e) => return Err(e),
@@ -246,9 +246,9 @@ impl Rig {
         Ok(SkinSkeleton::from_positions(names, parent, &pos)?)
     }
 
-    /// The rigged skeleton as an animation skeleton (`anim::Skeleton::from_joint_positions`).
+    /// The rigged skeleton as an animation skeleton (`anim::Skeleton::from_joint_positions`),
+    /// with the template's roles (where a joint has none, the role guessed from its name stays).
     pub fn anim_skeleton(&self) -> Result<geom_core::anim::Skeleton> {
-        let names: Vec<String> = self.template.joints.iter().map(|j| j.name.clone()).collect();
-        Ok(geom_core::anim::Skeleton::from_joint_positions(&names, &self.template.parents(), &self.joints)?)
+        self.template.anim_skeleton(&self.joints)
     }
 }

@@ -9,6 +9,7 @@
 
 use std::path::Path;
 
+use geom_core::anim::JointRole;
 use geom_core::math::Pt3;
 use serde::{Deserialize, Serialize};
 
@@ -34,6 +35,10 @@ pub struct TemplateJoint {
     /// Only large medial spheres are candidates (torso, head).
     #[serde(default)]
     pub fat: bool,
+    /// Semantic role for retargeting motion onto the rig (`geom_core::anim::JointRole`); `None`
+    /// = guessed from the name.
+    #[serde(default)]
+    pub role: Option<JointRole>,
 }
 
 /// A generic skeleton to embed.
@@ -108,7 +113,12 @@ impl ReducedSkeleton {
 }
 
 fn j(name: &str, rest: [f64; 3], parent: Option<usize>) -> TemplateJoint {
-    TemplateJoint { name: name.into(), rest, parent, symmetric_to: None, foot: false, fat: false }
+    TemplateJoint { name: name.into(), rest, parent, symmetric_to: None, foot: false, fat: false, role: None }
+}
+
+fn with_role(mut t: TemplateJoint, r: JointRole) -> TemplateJoint {
+    t.role = Some(r);
+    t
 }
 
 impl SkeletonTemplate {
@@ -126,28 +136,33 @@ impl SkeletonTemplate {
             let parent = s.parent.map(|p| if range.contains(&p) { base + p - range.start } else { p });
             let mut m = TemplateJoint { name, rest: [-s.rest[0], s.rest[1], s.rest[2]], parent, ..s.clone() };
             m.symmetric_to = Some(i);
+            m.role = s.role.map(JointRole::mirror);
             self.joints.push(m);
         }
     }
 
-    /// The built-in human (spec §3.5 table): 18 joints, 7 reduced; arms about 45° down.
+    /// The built-in human (spec §3.5 table): 18 joints, 7 reduced; arms about 45° down. Roles
+    /// for retargeting: shoulders = `Neck` (the base of the neck, where the collar bones start),
+    /// back = `Spine`, hips = `Root`, head = `Head`, thigh/knee/ankle/foot = `Hip`/`Knee`/`Ankle`/
+    /// `Toe`, shoulder/elbow/hand = `Shoulder`/`Elbow`/`Hand`.
     pub fn human() -> Self {
+        use JointRole::*;
         let mut s = SkeletonTemplate {
             joints: vec![
-                TemplateJoint { fat: true, ..j("shoulders", [0.0, 0.5, 0.0], None) },
-                j("back", [0.0, 0.17, 0.0], Some(0)),
-                TemplateJoint { fat: true, ..j("hips", [0.0, -0.05, 0.0], Some(1)) },
-                TemplateJoint { fat: true, ..j("head", [0.0, 0.75, 0.0], Some(0)) },
-                j("l_thigh", [0.1, -0.05, 0.0], Some(2)),
-                j("l_knee", [0.13, -0.42, 0.02], Some(4)),
-                j("l_ankle", [0.14, -0.82, 0.0], Some(5)),
-                TemplateJoint { foot: true, ..j("l_foot", [0.14, -0.84, 0.12], Some(6)) },
+                TemplateJoint { fat: true, ..with_role(j("shoulders", [0.0, 0.5, 0.0], None), Neck) },
+                with_role(j("back", [0.0, 0.17, 0.0], Some(0)), Spine),
+                TemplateJoint { fat: true, ..with_role(j("hips", [0.0, -0.05, 0.0], Some(1)), Root) },
+                TemplateJoint { fat: true, ..with_role(j("head", [0.0, 0.75, 0.0], Some(0)), Head) },
+                with_role(j("l_thigh", [0.1, -0.05, 0.0], Some(2)), LeftHip),
+                with_role(j("l_knee", [0.13, -0.42, 0.02], Some(4)), LeftKnee),
+                with_role(j("l_ankle", [0.14, -0.82, 0.0], Some(5)), LeftAnkle),
+                TemplateJoint { foot: true, ..with_role(j("l_foot", [0.14, -0.84, 0.12], Some(6)), LeftToe) },
             ],
         };
         s.mirror(4..8);
-        s.joints.push(j("l_shoulder", [0.19, 0.5, 0.0], Some(0)));
-        s.joints.push(j("l_elbow", [0.4, 0.26, 0.06], Some(12)));
-        s.joints.push(j("l_hand", [0.6, 0.02, 0.12], Some(13)));
+        s.joints.push(with_role(j("l_shoulder", [0.19, 0.5, 0.0], Some(0)), LeftShoulder));
+        s.joints.push(with_role(j("l_elbow", [0.4, 0.26, 0.06], Some(12)), LeftElbow));
+        s.joints.push(with_role(j("l_hand", [0.6, 0.02, 0.12], Some(13)), LeftHand));
         s.mirror(12..15);
         s
     }
@@ -269,6 +284,20 @@ impl SkeletonTemplate {
     /// Parents.
     pub fn parents(&self) -> Vec<Option<usize>> {
         self.joints.iter().map(|j| j.parent).collect()
+    }
+
+    /// An animation skeleton with this template's joints at `joints` (template order): names,
+    /// parents, offsets from the positions, the template's roles (overriding guesses from names).
+    pub fn anim_skeleton(&self, joints: &[Pt3]) -> Result<geom_core::anim::Skeleton> {
+        let names: Vec<String> = self.joints.iter().map(|j| j.name.clone()).collect();
+        let mut s = geom_core::anim::Skeleton::from_joint_positions(&names, &self.parents(), joints)?;
+        for (i, j) in self.joints.iter().enumerate() {
+            if let Some(r) = j.role {
+                s.roles.retain(|_, v| *v as usize != i);
+                s.roles.insert(r, i as u16);
+            }
+        }
+        Ok(s)
     }
 
     /// Index of the joint called `name`.

@@ -8,7 +8,7 @@ use rigging::template::{SkeletonTemplate, TemplateJoint};
 use rigging::{EmbedGraph, RigError, RigOptions};
 
 fn tj(name: &str, rest: [f64; 3], parent: Option<usize>) -> TemplateJoint {
-    TemplateJoint { name: name.into(), rest, parent, symmetric_to: None, foot: false, fat: false }
+    TemplateJoint { name: name.into(), rest, parent, symmetric_to: None, foot: false, fat: false, role: None }
 }
 
 /// A Y-shaped 4-joint template: root, two arms and a leg (r = 4).

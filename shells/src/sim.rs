@@ -609,7 +609,7 @@ impl ShellSim {
         self.finish_step(&q_base, h_eff, v_cur, &targets, h, st)
     }
 
-    /// 9. The end of a step: positions q_base + h_eff·v (prescribed vertices at their targets),
+    /// Step 9, the end of a step: positions q_base + h_eff·v (prescribed vertices at their targets),
     /// the NaN and energy checks, and the state update.
     fn finish_step(
         &mut self,

@@ -5,12 +5,12 @@
 use std::time::Instant;
 
 use geom_core::collide::MeshQuery;
-use geom_core::procedural::character::{build_mesh, humanoid};
 use rigging::characters::test_params;
 use rigging::eval::score;
+use rigging::presets::humanoid_character;
 use rigging::{autorig, RigOptions, SkeletonTemplate};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::out::{CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
 use crate::registry::BenchCtx;
@@ -26,9 +26,8 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     let chars: Vec<_> = seeds
         .iter()
         .map(|&s| {
-            let (sdf, truth) = humanoid(&test_params(s)).map_err(|e| Error::Run(e.to_string()))?;
-            let m = build_mesh(&sdf, nv).map_err(|e| Error::Run(e.to_string()))?;
-            let q = MeshQuery::new(&m).map_err(|e| Error::Run(e.to_string()))?;
+            let (m, truth) = humanoid_character(&test_params(s), nv)?;
+            let q = MeshQuery::new(&m)?;
             Ok((m, truth, q))
         })
         .collect::<Result<_>>()?;

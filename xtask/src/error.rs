@@ -8,8 +8,9 @@ pub enum Error {
     /// An error from geom-core (mesh, file formats, solvers …).
     #[error(transparent)]
     Core(#[from] geom_core::Error),
-    /// A scene file that cannot be read or does not describe a valid scene.
-    #[error("{file}:{line}:{col}: {msg}")]
+    /// A scene file that cannot be read or does not describe a valid scene: `file:line:col: msg`
+    /// (`file: msg` while the line is not known, `line` 0).
+    #[error("{}", scene_place(file, *line, *col, msg))]
     Scene { file: PathBuf, line: usize, col: usize, msg: String },
     /// A file or directory could not be read or written.
     #[error("{path}: {source}")]
@@ -23,6 +24,14 @@ pub enum Error {
     /// A scene or benchmark ran but failed (a method error, a violated invariant).
     #[error("{0}")]
     Run(String),
+}
+
+fn scene_place(file: &std::path::Path, line: usize, col: usize, msg: &str) -> String {
+    if line == 0 {
+        format!("{}: {msg}", file.display())
+    } else {
+        format!("{}:{line}:{col}: {msg}", file.display())
+    }
 }
 
 /// Result alias of xtask.

@@ -19,16 +19,17 @@ pub fn inspect(path: &Path) -> Result<()> {
     }
     let mesh = geom_core::io::read_any(path)?;
     let d = diagnose(&mesh);
-    println!("{}", path.display());
-    print!("{}", d.render());
+    say!("{}", path.display());
+    say!("{}", d.render().trim_end());
     Ok(())
 }
 
 fn inspect_bvh(path: &Path) -> Result<()> {
     let text = std::fs::read_to_string(path).map_err(io_err(path))?;
-    let info = geom_core::anim::bvh::inspect(&text)?;
-    println!("{}", path.display());
-    print!("{info}");
+    let info = geom_core::anim::bvh::inspect(&text)
+        .map_err(|e| geom_core::Error::InFile { path: path.to_path_buf(), source: Box::new(e) })?;
+    say!("{}", path.display());
+    say!("{}", info.to_string().trim_end());
     Ok(())
 }
 

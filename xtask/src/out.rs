@@ -8,15 +8,32 @@ use std::path::{Path, PathBuf};
 
 use crate::error::{io_err, Result};
 
-/// The workspace root (the parent of this crate's manifest directory).
+/// What the runners written before `RunCtx::resolve` join a scene's relative paths to: while a
+/// scene runs, the scene file's folder (issue 23: a path in a scene file resolves against that
+/// file's folder); otherwise the folder holding the built-in `scenes/` and `assets/`, found at run
+/// time ([`crate::paths::relative_base`]). New code uses `RunCtx::resolve`.
 pub fn workspace_root() -> PathBuf {
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    manifest.parent().unwrap_or(manifest).to_path_buf()
+    crate::paths::relative_base()
 }
 
-/// The default output root, `<workspace>/out`.
+/// The default output root ([`crate::paths::default_out_root`]).
 pub fn default_out_root() -> PathBuf {
-    workspace_root().join("out")
+    crate::paths::default_out_root()
+}
+
+/// Writes `path` atomically: the bytes go to a temporary file beside it, which is then renamed
+/// over `path`, so a reader (or a resumed sweep) never sees a half-written file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    let mut f = fs::File::create(&tmp).map_err(io_err(&tmp))?;
+    f.write_all(bytes).map_err(io_err(&tmp))?;
+    f.sync_all().map_err(io_err(&tmp))?;
+    drop(f);
+    fs::rename(&tmp, path).map_err(|e| {
+        let _ = fs::remove_file(&tmp);
+        crate::error::Error::Io { path: path.to_path_buf(), source: e }
+    })
 }
 
 /// Creates a directory and its parents.
@@ -79,13 +96,18 @@ impl Summary {
         self.values.iter()
     }
 
-    /// Writes `dir/summary.json` (pretty-printed, keys sorted).
+    /// Writes `dir/summary.json` (pretty-printed, keys sorted) atomically ([`write_atomic`]).
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         ensure_dir(dir)?;
         let path = dir.join("summary.json");
         let text = serde_json::to_string_pretty(&self.values).map_err(|e| crate::error::Error::Run(e.to_string()))?;
-        fs::write(&path, text + "\n").map_err(io_err(&path))?;
+        write_atomic(&path, (text + "\n").as_bytes())?;
         Ok(path)
+    }
+
+    /// The raw JSON value of `key`.
+    pub fn value(&self, key: &str) -> Option<&serde_json::Value> {
+        self.values.get(key)
     }
 
     /// Reads a `summary.json` back.
@@ -190,6 +212,30 @@ mod tests {
         assert_eq!(back.get("frames"), Some(12.0));
         assert!(back.get("nan_value").is_none());
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn atomic_writes_replace_whole_files_and_leave_no_temporary() {
+        let dir = std::env::temp_dir().join(format!("xtask-atomic-{}", std::process::id()));
+        let _ = fs::remove_dir_all(&dir);
+        fs::create_dir_all(&dir).unwrap();
+        let mut s = Summary::new();
+        s.set("a", 1.0);
+        s.write(&dir).unwrap();
+        s.set("b", 2.0);
+        s.write(&dir).unwrap();
+        assert_eq!(Summary::read(&dir.join("summary.json")).unwrap().get("b"), Some(2.0));
+        let names: Vec<String> =
+            fs::read_dir(&dir).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, ["summary.json"], "no temporary file left");
+        // A failed write leaves neither the target nor a temporary file.
+        let e = write_atomic(&dir.join("missing/x.json"), b"{}").unwrap_err();
+        assert!(e.to_string().contains("missing"), "{e}");
+        assert!(write_atomic(&dir, b"{}").is_err(), "a folder cannot be replaced by a file");
+        let names: Vec<String> =
+            fs::read_dir(&dir).unwrap().flatten().map(|e| e.file_name().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, ["summary.json"]);
+        fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -13,7 +13,7 @@ static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 static REGISTER: Once = Once::new();
 
 /// Registers the bundled font under the family name "sans-serif" (once per process).
-fn register_font() {
+pub(crate) fn register_font() {
     REGISTER.call_once(|| {
         // The font is compiled into the binary; a parse failure would be a build defect that
         // every plot test catches, so it is reported there rather than here.

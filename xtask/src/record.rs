@@ -72,12 +72,13 @@ impl FileRecorder {
         &self.dir
     }
 
-    /// Draws the plots (one PNG per plot name). Call once when the experiment returns.
+    /// Draws the plots (one PNG per plot name) and keeps the scene items in `scene.json` (for
+    /// previews and reports rebuilt later). Call once when the experiment returns.
     pub fn finish(&mut self) -> Result<()> {
         for (name, p) in &self.plots {
             p.write_png(&self.dir.join(format!("{name}.png")))?;
         }
-        Ok(())
+        crate::scene_items::write(&self.dir, &self.scene)
     }
 }
 
@@ -145,6 +146,10 @@ impl Recorder for FileRecorder {
         writeln!(f, "{text}").map_err(core_io(&path))
     }
 
+    fn progress(&mut self, done: u64, total: u64) {
+        crate::ui::progress(done, total);
+    }
+
     fn file(&mut self, name: &str, bytes: &[u8]) -> geom_core::Result<()> {
         let path = self.dir.join(name);
         if let Some(parent) = path.parent() {
@@ -190,8 +195,10 @@ where
 {
     let sc = scene::load::<P>(&ctx.scene_file)?;
     let mut rec = FileRecorder::new(&ctx.out_dir)?;
-    let report = f(&sc.params, ctx.mode.size(), &mut rec)?;
+    let report = f(&sc.params, ctx.mode.size(), &mut rec);
+    // The scene items and plots of a failed run are kept too (the frames already are).
     rec.finish()?;
+    let report = report?;
     write_checks(&ctx.out_dir, &report)?;
     Ok(Summary::from_report(&report))
 }

@@ -22,6 +22,22 @@ pub struct RunCtx {
     pub out_dir: PathBuf,
 }
 
+impl RunCtx {
+    /// A context for running `scene_file` at `mode` into `out_dir`.
+    pub fn new(scene_file: &Path, mode: Mode, out_dir: &Path) -> Self {
+        Self { scene_file: scene_file.to_path_buf(), mode, out_dir: out_dir.to_path_buf() }
+    }
+
+    /// A path written in the scene file, resolved against the scene file's folder (absolute paths
+    /// stay as they are): `Obj(path: "mygrid.obj")` in `/home/u/shot.ron` is
+    /// `/home/u/mygrid.obj`, wherever the command runs from. Built-in scenes reach the shipped
+    /// assets as `../../assets/…`.
+    #[allow(dead_code)] // called by the crates' adapters as they move onto `run_experiment` (issue 21)
+    pub fn resolve(&self, path: impl AsRef<Path>) -> PathBuf {
+        crate::paths::resolve_in(&self.scene_file, path.as_ref())
+    }
+}
+
 /// A scene runner: reads its parameters from the scene file, computes, writes outputs into
 /// `out_dir`, and returns the figures of `summary.json`.
 pub struct Runner {
@@ -34,8 +50,11 @@ pub struct Runner {
 /// What a benchmark is given.
 #[derive(Clone, Debug)]
 pub struct BenchCtx {
-    /// Reduced sweep (smoke test).
+    /// Reduced sweep (smoke test; `repro` runs it by default).
     pub quick: bool,
+    /// Paper-scale sweep (`--full`); a bench with one scale treats it as the default.
+    #[allow(dead_code)] // read by the benches as they gain full sweeps (issue 22, item 6)
+    pub full: bool,
     /// `out/bench/<crate>/` (created before the benchmark is called).
     pub out_dir: PathBuf,
     /// `--sweep <knob>`: run only this sweep (one of the bench's [`Bench::sweeps`], or `all`);
@@ -64,11 +83,10 @@ pub fn runners() -> Vec<Runner> {
     crate::scenes::tracks::register(&mut v);
     crate::scenes::tracks_variants::register(&mut v);
     crate::scenes::curve_skin::register(&mut v);
-    crate::scenes::rigging::register(&mut v);
-    crate::scenes::motion_graph::register(&mut v);
+    crate::crates::rigging::register(&mut v);
+    crate::crates::motion_graph::register(&mut v);
     crate::scenes::perf_control::register(&mut v);
-    crate::scenes::flip_tet::register(&mut v);
-    crate::scenes::flip_tet_adaptive::register(&mut v);
+    crate::crates::flip_tet::register(&mut v);
     crate::scenes::wrinkles::register(&mut v);
     v
 }
@@ -152,9 +170,10 @@ pub struct BuiltinScene {
     pub description: String,
 }
 
-/// Every built-in scene under `scenes/`, sorted by id.
+/// Every built-in scene under `scenes/` (found at run time, [`crate::paths::scenes_dir`]),
+/// sorted by id.
 pub fn builtin_scenes() -> Result<Vec<BuiltinScene>> {
-    builtin_scenes_in(&scene::scenes_dir())
+    builtin_scenes_in(&crate::paths::scenes_dir()?)
 }
 
 /// Every scene file under `dir/<crate>/*.ron`, sorted by id.
@@ -193,10 +212,11 @@ pub fn builtin_scenes_in(dir: &Path) -> Result<Vec<BuiltinScene>> {
 pub fn resolve_target(target: &str) -> Result<(String, PathBuf)> {
     let as_path = Path::new(target);
     if target.ends_with(".ron") || as_path.is_file() {
-        let h = scene::load_header(as_path)?;
+        let abs = crate::paths::absolute(as_path);
+        let h = scene::load_header(&abs)?;
         let crate_name = h.method.split('/').next().unwrap_or("scene").to_string();
         let stem = as_path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "scene".into());
-        return Ok((format!("{crate_name}/{stem}"), as_path.to_path_buf()));
+        return Ok((format!("{crate_name}/{stem}"), abs));
     }
     let scenes = builtin_scenes()?;
     match scenes.iter().find(|s| s.id == target) {
@@ -211,6 +231,25 @@ pub fn resolve_target(target: &str) -> Result<(String, PathBuf)> {
                 "no built-in scene '{target}' and no such .ron file{}; `cargo xtask list` shows every scene",
                 if close.is_empty() { String::new() } else { format!(" (this crate has: {})", close.join(", ")) }
             )))
+        }
+    }
+}
+
+/// The runner a scene file names, or an error at the line of its `method` naming the known ones.
+pub fn runner_for(file: &Path) -> Result<Runner> {
+    let header = scene::load_header(file)?;
+    let mut runners = runners();
+    match runners.iter().position(|r| r.method == header.method) {
+        Some(i) => Ok(runners.swap_remove(i)),
+        None => {
+            let known: Vec<&str> = runners.iter().map(|r| r.method).collect();
+            let text = std::fs::read_to_string(file).map_err(io_err(file))?;
+            Err(scene::at_field(
+                file,
+                &text,
+                "method",
+                format!("unknown method '{}'; known: {}", header.method, known.join(", ")),
+            ))
         }
     }
 }

@@ -130,22 +130,12 @@ pub struct Percentiles {
     pub p99: f64,
 }
 
-/// Percentile `q ∈ [0, 100]` of `xs` by linear interpolation between order statistics
-/// (NaNs ignored); 0 for an empty sample.
+/// Percentile `q ∈ [0, 100]` of `xs` by linear interpolation between order statistics: the one
+/// copy in [`crate::stats::percentile`]. NaN for an empty sample or one holding a NaN, so a
+/// figure computed from a failed (or missing) run never reads as 0 (issue 21; this function used
+/// to drop NaNs and return 0 for an empty sample).
 pub fn percentile(xs: &[f64], q: f64) -> f64 {
-    let mut v: Vec<f64> = xs.iter().copied().filter(|x| !x.is_nan()).collect();
-    if v.is_empty() {
-        return 0.0;
-    }
-    v.sort_by(f64::total_cmp);
-    let r = (q.clamp(0.0, 100.0) / 100.0) * (v.len() - 1) as f64;
-    let i = r.floor() as usize;
-    let s = r - i as f64;
-    if i + 1 < v.len() {
-        v[i] + (v[i + 1] - v[i]) * s
-    } else {
-        v[i]
-    }
+    crate::stats::percentile(xs, q)
 }
 
 impl Percentiles {
@@ -235,4 +225,20 @@ pub fn stick_figure(m: &Motion, frame: usize, radius: f64) -> Result<TriMesh> {
         faces.extend(CUBE.iter().map(|t| [t[0] + base, t[1] + base, t[2] + base]));
     }
     TriMesh::new(pos, faces)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 21: an empty sample or a NaN in it gives NaN, never 0 (a failed run must not read as
+    /// a perfect one); ordinary samples interpolate as before.
+    #[test]
+    fn percentile_of_empty_or_nan_samples_is_nan() {
+        assert!(percentile(&[], 90.0).is_nan());
+        assert!(percentile(&[0.1, f64::NAN, 0.3], 50.0).is_nan());
+        assert_eq!(percentile(&[0.0, 10.0], 90.0), 9.0);
+        let p = Percentiles::of(&[]);
+        assert!(p.p50.is_nan() && p.p95.is_nan() && p.p99.is_nan());
+    }
 }

@@ -11,6 +11,7 @@ pub mod bvh;
 pub mod ik;
 pub mod metrics;
 pub mod motion;
+pub mod retarget;
 pub mod skeleton;
 pub mod skin;
 pub mod synth;

@@ -47,6 +47,25 @@ pub fn write_png_gray8(path: impl AsRef<Path>, img: &ImageF32) -> Result<()> {
     write_png(path.as_ref(), img.width, img.height, png::ColorType::Grayscale, png::BitDepth::Eight, &bytes)
 }
 
+/// Encodes an image as an 8-bit grayscale PNG in memory (the bytes [`write_png_gray8`] writes),
+/// for outputs handed to a [`crate::record::Recorder`] as files.
+pub fn png_gray8_bytes(img: &ImageF32) -> Result<Vec<u8>> {
+    if img.width == 0 || img.height == 0 {
+        return Err(Error::Image(format!("cannot encode an empty {}×{} PNG", img.width, img.height)));
+    }
+    let bytes: Vec<u8> = img.data.iter().map(|&v| quantize(v, 255.0) as u8).collect();
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, img.width, img.height);
+        enc.set_color(png::ColorType::Grayscale);
+        enc.set_depth(png::BitDepth::Eight);
+        let mut writer = enc.write_header().map_err(|e| Error::Image(e.to_string()))?;
+        writer.write_image_data(&bytes).map_err(|e| Error::Image(e.to_string()))?;
+        writer.finish().map_err(|e| Error::Image(e.to_string()))?;
+    }
+    Ok(out)
+}
+
 /// Writes a 16-bit grayscale PNG: each value `v` becomes `round(v · scale)` clamped to
 /// `0..=65535` (NaN → 0). Use `scale = 65535` for `[0, 1]` data (then [`read_png`] returns `v` to
 /// within `1/131070`), or e.g. `scale = 1000` to store depths in millimetres.

@@ -33,6 +33,11 @@ pub(crate) fn with_path(e: Error, path: &Path) -> Error {
     }
 }
 
+/// The error for a mesh file that holds no mesh: it names the file and says it is empty.
+pub(crate) fn empty_mesh(format: &'static str, path: &Path, what: &str) -> Error {
+    Error::Parse { format, line: 0, msg: format!("the mesh is empty ({what}) (in {})", path.display()) }
+}
+
 /// Creates (truncates) `path` and hands a buffered writer to `body`; every I/O error, including
 /// the final flush, names the path. Errors returned by `body` that are not I/O pass unchanged.
 pub(crate) fn write_file(path: &Path, body: impl FnOnce(&mut dyn Write) -> Result<()>) -> Result<()> {

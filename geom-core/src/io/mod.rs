@@ -1,5 +1,6 @@
 //! Mesh files (GEOM-CORE.md §3.5): Wavefront OBJ ([`obj`]), PLY ([`ply`], ASCII and binary,
-//! meshes or point sets with named per-vertex attributes), OFF ([`off`], read only), format
+//! meshes or point sets with named per-vertex attributes), OFF ([`off`], read only), time-sampled
+//! USD text for animated meshes ([`usd`], write only), format
 //! detection ([`read_any`]) and numbered OBJ frame sequences ([`frame_path`],
 //! [`read_obj_sequence`], [`write_obj_frame`]).
 //!
@@ -28,9 +29,11 @@ mod sniff;
 mod text;
 mod tri;
 
+pub mod gltf;
 pub mod obj;
 pub mod off;
 pub mod ply;
+pub mod usd;
 
 pub use out::{Faces, MeshOut, Positions};
 pub use ply::{Encoding, PlyData};

@@ -5,7 +5,7 @@ use std::path::Path;
 use crate::error::{Error, Result};
 use crate::mesh::PolyMesh;
 
-use super::fs::{read_file, with_path};
+use super::fs::{empty_mesh, read_file, with_path};
 use super::text::{lines, strip_bom, tokens};
 use super::{obj, off, ply};
 
@@ -55,7 +55,8 @@ pub fn sniff(data: &[u8]) -> Option<MeshFormat> {
 /// Reads a mesh file of any supported format as a polygon mesh (PLY properties other than UVs
 /// are dropped; use [`ply::read_data`] to keep them). The format comes from the extension
 /// (`.obj`, `.ply`, `.off`, any case), otherwise from [`sniff`]; a file that is neither is an
-/// [`Error::Parse`] (format `"mesh"`, line 0) saying so.
+/// [`Error::Parse`] (format `"mesh"`, line 0) saying so; a file with neither vertices nor faces
+/// (an empty file) is an [`Error::Parse`] saying the mesh is empty, naming the file.
 pub fn read_any(path: impl AsRef<Path>) -> Result<PolyMesh> {
     let path = path.as_ref();
     let data = read_file(path)?;
@@ -79,5 +80,14 @@ pub fn read_any(path: impl AsRef<Path>) -> Result<PolyMesh> {
             ),
         }),
     };
-    r.map_err(|e| with_path(e, path))
+    let m = r.map_err(|e| with_path(e, path))?;
+    if m.positions.is_empty() && m.faces.is_empty() {
+        let format = match fmt {
+            Some(MeshFormat::Ply) => "PLY",
+            Some(MeshFormat::Off) => "OFF",
+            _ => "OBJ",
+        };
+        return Err(empty_mesh(format, path, "no vertices, no faces"));
+    }
+    Ok(m)
 }

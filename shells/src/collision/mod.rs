@@ -356,12 +356,14 @@ impl Collider {
                     let rel = v[i] - vo;
                     let vn = rel.dot(&nrm);
                     // Below h_c: no approach plus a small separation; farther: stop at 0.9 h_c.
+                    // (A former extra clamp, max(vn_min, min(h_c(1 − f) − min(d₀, d_end), 0)/h),
+                    // was 0 whenever the end point came within 0.9 h_c, stopping vertices up to a
+                    // whole step's travel away: the first source of energy in fold-stress.)
                     let vn_min = if p0.distance < hc {
                         (fsep * (hc - p0.distance) / h).max(0.0)
                     } else {
                         (0.9 * hc - p0.distance) / h
                     };
-                    let vn_min = vn_min.max((hc * (1.0 - fsep) - pe.distance.min(p0.distance)).min(0.0) / h);
                     if vn >= vn_min {
                         return None;
                     }

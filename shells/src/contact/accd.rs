@@ -94,7 +94,7 @@ mod tests {
         let t = time_of_impact(&x, &p, 1, pp, 0.0, 0.1, 0.0, 1.0).expect("they meet");
         // The gap at t is ≥ 0.1 and the search stops once it is below 0.1·(1/0.9)-ish.
         let gap = 1.0 - 2.0 * t;
-        assert!(gap >= 0.1 - 1e-12 && gap < 0.2, "t = {t}, gap = {gap}");
+        assert!((0.1 - 1e-12..0.2).contains(&gap), "t = {t}, gap = {gap}");
         // With thickness 0.5 the gap is 0.5 and closes at t = 0.25.
         let t = time_of_impact(&x, &p, 1, pp, 0.5, 0.1, 0.0, 1.0).expect("they meet");
         assert!(1.0 - 2.0 * t - 0.5 >= 0.05 - 1e-12 && t < 0.25);

@@ -88,8 +88,8 @@ impl FrictionContact {
         self.mu_lambda * f0(self.u(x, x0).norm(), eps)
     }
 
-    /// Adds −∇D to `force` and the PSD Hessian blocks (scaled by `scale`) through
-    /// `block(i, j, m)`; blocks of vertex pairs outside `in_pattern` are lumped onto both
+    /// Adds −∇D to `force` and the PSD Hessian blocks through `block(i, j, m)` (a caller that
+    /// scales the Hessian does so in `block`); blocks of vertex pairs outside `in_pattern` are lumped onto both
     /// diagonals as |w_i w_j|·S (see `Ipc::add`).
     pub fn add(
         &self,
@@ -97,7 +97,6 @@ impl FrictionContact {
         x0: &[Pt3],
         eps: f64,
         force: &mut [Vec3],
-        scale: f64,
         in_pattern: &impl Fn(u32, u32) -> bool,
         mut block: impl FnMut(u32, u32, Mat3),
     ) {
@@ -118,7 +117,7 @@ impl FrictionContact {
         } else {
             Matrix2::identity() * (ml * fy)
         };
-        let h3 = self.basis * hu * self.basis.transpose() * scale;
+        let h3 = self.basis * hu * self.basis.transpose();
         for (a, &(i, wi)) in self.cloth.iter().enumerate() {
             block(i, i, h3 * (wi * wi));
             for &(j, wj) in &self.cloth[a + 1..] {
@@ -160,14 +159,14 @@ mod tests {
         // Sliding 1 cm along x: force μλ = 1 N against the motion.
         let x = vec![Pt3::new(0.01, 0.001, 0.0)];
         let mut force = vec![Vec3::zeros()];
-        f.add(&x, &x0, eps, &mut force, 1.0, &|_, _| true, |_, _, _| {});
+        f.add(&x, &x0, eps, &mut force, &|_, _| true, |_, _, _| {});
         assert!((force[0] - Vec3::new(-1.0, 0.0, 0.0)).norm() < 1e-12, "{:?}", force[0]);
         // Energy gradient by finite differences, in the smooth and the sliding regime.
         for dx in [3e-5, 0.01] {
             let x = vec![Pt3::new(dx, 0.001, 0.7 * dx)];
             let mut force = vec![Vec3::zeros()];
             let mut h = Mat3::zeros();
-            f.add(&x, &x0, eps, &mut force, 1.0, &|_, _| true, |_, _, m| h += m);
+            f.add(&x, &x0, eps, &mut force, &|_, _| true, |_, _, m| h += m);
             for k in 0..3 {
                 let e = 1e-9;
                 let (mut xp, mut xm) = (x.clone(), x.clone());
@@ -188,7 +187,7 @@ mod tests {
         // The floor slides +x by 1 cm in the step; the vertex stays: relative slip −1 cm.
         let f = FrictionContact::new(&c, &x0, 2.0, |_| Vec3::new(0.01, 0.0, 0.0)).unwrap();
         let mut force = vec![Vec3::zeros()];
-        f.add(&x0, &x0, 1e-4, &mut force, 1.0, &|_, _| true, |_, _, _| {});
+        f.add(&x0, &x0, 1e-4, &mut force, &|_, _| true, |_, _, _| {});
         assert!(force[0].x > 0.99, "dragged along: {:?}", force[0]);
     }
 }

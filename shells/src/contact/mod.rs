@@ -326,7 +326,7 @@ impl Ipc {
             }
         }
         for f in &self.friction {
-            f.add(x, &self.x0, self.eps, force, scale, &in_pattern, &mut block);
+            f.add(x, &self.x0, self.eps, force, &in_pattern, |i, j, m| block(i, j, m * scale));
         }
         min_gap
     }

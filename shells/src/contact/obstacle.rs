@@ -20,7 +20,7 @@ pub(crate) enum Placed {
         offset: f64,
     },
     /// Core primitives thickened by `xi`.
-    Core(Core),
+    Core(Box<Core>),
 }
 
 /// Core primitives of a rounded or mesh obstacle, in world coordinates at the step's end.
@@ -73,14 +73,17 @@ pub(crate) fn place(o: &Obstacle, iso: &Iso3, edges: &[[u32; 2]]) -> Placed {
             Placed::Half { normal: nw, offset: nw.dot(&p.coords) }
         }
         ObstacleShape::Sphere { center, radius } => {
-            Placed::Core(Core::new(*radius, vec![iso * center], vec![], vec![]))
+            Placed::Core(Box::new(Core::new(*radius, vec![iso * center], vec![], vec![])))
         }
         ObstacleShape::Capsule { a, b, radius } => {
-            Placed::Core(Core::new(*radius, vec![iso * a, iso * b], vec![[0, 1]], vec![]))
+            Placed::Core(Box::new(Core::new(*radius, vec![iso * a, iso * b], vec![[0, 1]], vec![])))
         }
-        ObstacleShape::Mesh { verts, tris } => {
-            Placed::Core(Core::new(0.0, verts.iter().map(|p| iso * p).collect(), edges.to_vec(), tris.clone()))
-        }
+        ObstacleShape::Mesh { verts, tris } => Placed::Core(Box::new(Core::new(
+            0.0,
+            verts.iter().map(|p| iso * p).collect(),
+            edges.to_vec(),
+            tris.clone(),
+        ))),
     }
 }
 

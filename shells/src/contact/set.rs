@@ -420,7 +420,7 @@ fn core_contacts(topo: &Topo, x: &[Pt3], o: u32, core: &Core, c: &CoreCands, mu:
 
 /// Sorts by key and keeps one contact per key.
 pub(crate) fn dedup(mut c: Vec<Contact>) -> Vec<Contact> {
-    c.sort_by(|a, b| a.key.cmp(&b.key));
+    c.sort_by_key(|a| a.key);
     c.dedup_by(|a, b| a.key == b.key);
     c
 }
@@ -443,6 +443,9 @@ pub(crate) fn boxes(
     (vb, eb, tb)
 }
 
+/// Candidate pairs: (vertex, triangle) and (edge, edge) indices.
+pub(crate) type CandidatePairs = (Vec<(u32, u32)>, Vec<(u32, u32)>);
+
 /// Self-contact candidate pairs (vertex–triangle, edge–edge) of the given boxes.
 pub(crate) fn self_candidates(
     bp: &mut BroadPhase,
@@ -450,7 +453,7 @@ pub(crate) fn self_candidates(
     vb: &[Aabb],
     eb: &[Aabb],
     tb: &[Aabb],
-) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
+) -> CandidatePairs {
     bp.candidate_pairs(topo.tris, topo.edges, vb, tb, eb)
 }
 

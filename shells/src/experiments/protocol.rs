@@ -199,7 +199,7 @@ pub fn run(
     }
     let record = |sim: &ShellSim, f: usize, rec: &mut dyn Recorder, rs: &mut RunStats| -> Result<()> {
         let mut inter = -1i64;
-        if plan.frame_every > 0 && f % plan.frame_every == 0 {
+        if plan.frame_every > 0 && f.is_multiple_of(plan.frame_every) {
             let strain = edge_strain_per_vertex(sim);
             let attrs = [Attribute { name: "strain", values: &strain }];
             rec.frame(&MeshFrame {

@@ -1,5 +1,8 @@
-//! Per-crate adapters: each loads a scene file's `params` as the crate's own experiment
-//! parameters, runs the crate's experiment with the file-writing recorder and returns the
-//! figures for `summary.json` (issue 21).
+//! Per-crate adapters (issue 21): each loads a scene's `params` block, calls the crate's
+//! experiment with a file recorder ([`crate::record::run_experiment`]) and returns the figures
+//! of `summary.json`. Each module's `register` adds its runners.
 
+pub mod flip_tet;
+pub mod motion_graph;
+pub mod rigging;
 pub mod shells;

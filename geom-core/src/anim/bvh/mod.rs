@@ -306,11 +306,15 @@ pub fn read_with_info(text: &str, opts: &BvhOptions) -> Result<(Motion, BvhInfo)
     Ok((m, info))
 }
 
-/// Reads a BVH file (see [`read`]). Errors: [`Error::Io`] when the file cannot be read; bytes that
+/// Reads a BVH file (see [`read`]). Errors name the file: [`Error::Io`] (its kind kept, the path in
+/// its message) when the file cannot be read, [`Error::InFile`] around any other error; bytes that
 /// are not UTF-8 are replaced (they can only occur in names).
 pub fn read_file(path: impl AsRef<Path>, opts: &BvhOptions) -> Result<Motion> {
-    let bytes = std::fs::read(path.as_ref())?;
+    let path = path.as_ref();
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::Io(std::io::Error::new(e.kind(), format!("cannot read {}: {e}", path.display()))))?;
     read(&String::from_utf8_lossy(&bytes), opts)
+        .map_err(|e| Error::InFile { path: path.to_path_buf(), source: Box::new(e) })
 }
 
 /// Reports what a BVH text holds — joints, channels, declared frame count, rows actually present,

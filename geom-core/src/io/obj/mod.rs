@@ -44,7 +44,7 @@ use crate::math::{Pt2, Pt3, Vec3};
 use crate::mesh::{PolyMesh, TriMesh};
 use crate::NONE;
 
-use super::fs::{read_file, with_path};
+use super::fs::{empty_mesh, read_file, with_path};
 use super::tri::{build_tri, consistent_vertex_uv, SourceUv};
 use super::ReadOptions;
 
@@ -109,10 +109,15 @@ impl ObjData {
     }
 }
 
-/// Reads an OBJ file into [`ObjData`]; errors name the line and the path.
+/// Reads an OBJ file into [`ObjData`]; errors name the line and the path. A file with neither
+/// vertices nor faces is an error saying the mesh is empty.
 pub fn read_data(path: impl AsRef<Path>) -> Result<ObjData> {
     let path = path.as_ref();
-    parse(&read_file(path)?).map_err(|e| with_path(e, path))
+    let d = parse(&read_file(path)?).map_err(|e| with_path(e, path))?;
+    if d.positions.is_empty() && d.faces.is_empty() {
+        return Err(empty_mesh("OBJ", path, "no vertices, no faces"));
+    }
+    Ok(d)
 }
 
 /// Reads an OBJ file as a polygon mesh (all objects merged; per-vertex UVs when consistent).
@@ -133,9 +138,15 @@ pub fn read_tri(path: impl AsRef<Path>) -> Result<TriMesh> {
     read_tri_with(path, &ReadOptions::default())
 }
 
-/// As [`read_tri`] with options (explicit vertex welding).
+/// As [`read_tri`] with options (explicit vertex welding). A file without faces is an error
+/// saying the mesh is empty.
 pub fn read_tri_with(path: impl AsRef<Path>, opts: &ReadOptions) -> Result<TriMesh> {
-    read_data(path)?.to_tri(opts)
+    let path = path.as_ref();
+    let d = read_data(path)?;
+    if d.faces.is_empty() {
+        return Err(empty_mesh("OBJ", path, &format!("{} vertices, no faces", d.positions.len())));
+    }
+    d.to_tri(opts)
 }
 
 /// Parses OBJ text as a validated triangle mesh.

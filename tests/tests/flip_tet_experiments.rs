@@ -1,0 +1,94 @@
+//! Every flip-tet experiment at `Size::Tiny` through the no-op recorder: the figures are bitwise
+//! identical with 1 and 2 rayon threads, and the paper checks that are meaningful at that size
+//! pass (the resting pools, the exact nodal projection). The tiny sizes are set here (the scene
+//! files and presets give quick / default / full).
+
+use flip_tet::experiments as ex;
+use flip_tet::presets;
+use geom_core::experiment::{BySize, Report, Size};
+use geom_core::record::{NullRecorder, Recorder};
+use tests::{assert_checks_pass, assert_thread_independent};
+
+type Run<P> = fn(&P, Size, &mut dyn Recorder) -> flip_tet::error::Result<Report>;
+
+fn tiny<P>(p: &P, run: Run<P>) -> Report {
+    run(p, Size::Tiny, &mut NullRecorder::default()).expect("the experiment runs at the tiny size")
+}
+
+/// `b` with `tiny` as its tiny-size value.
+fn t<T: Clone>(b: &BySize<T>, tiny: T) -> BySize<T> {
+    BySize::Named {
+        quick: b.get(Size::Quick),
+        default: b.get(Size::Default),
+        full: b.get(Size::Full),
+        tiny: Some(tiny),
+    }
+}
+
+#[test]
+fn rest_pool_rests_and_is_thread_independent() {
+    let mut p = presets::rest_pool();
+    (p.finest, p.duration) = (t(&p.finest, 8), t(&p.duration, 5.0 / 120.0));
+    p.variants.jitter_steps = t(&p.variants.jitter_steps, 6);
+    p.variants.finest = Some(BySize::Same(8));
+    let r = assert_thread_independent("rest-pool", || tiny(&p, ex::rest_pool::run));
+    assert_checks_pass("rest-pool", &r);
+    assert!(r.get_f64("s1b_first_order_max_speed") > 1e-4, "first order moves the offset pool");
+}
+
+#[test]
+fn dam_break_is_thread_independent() {
+    let mut p = presets::dam_break();
+    (p.finest, p.duration) = (t(&p.finest, 16), t(&p.duration, 0.03));
+    let r = assert_thread_independent("dam-break", || tiny(&p, ex::dam_break::run));
+    assert!(r.get_f64("front_rms_rel_err").is_finite());
+}
+
+#[test]
+fn standing_wave_is_thread_independent() {
+    let mut p = presets::standing_wave();
+    (p.finest, p.duration) = (t(&p.finest, 8), t(&p.duration, 0.05));
+    p.variants.finest = Some(BySize::Same(8));
+    assert_thread_independent("standing-wave", || tiny(&p, ex::standing_wave::run));
+}
+
+#[test]
+fn drop_pool_and_adaptivity_payoff_are_thread_independent() {
+    let mut p = presets::drop_pool();
+    (p.finest, p.duration) = (t(&p.finest, 16), t(&p.duration, 0.05));
+    assert_thread_independent("drop-pool", || tiny(&p, ex::drop_pool::run));
+    let mut p = presets::adaptivity_payoff();
+    (p.finest, p.duration, p.sizes) = (t(&p.finest, 16), t(&p.duration, 0.04), t(&p.sizes, vec![16]));
+    let r = assert_thread_independent("adaptivity-payoff", || tiny(&p, ex::adaptivity_payoff::run));
+    assert!(r.get_f64("particle_ratio_adaptive_over_uniform") < 1.0);
+}
+
+#[test]
+fn holes_plate_is_thread_independent() {
+    let mut p = presets::holes_plate();
+    (p.finest, p.duration) = (t(&p.finest, 16), t(&p.duration, 0.04));
+    let r = assert_thread_independent("holes-plate", || tiny(&p, ex::holes_plate::run));
+    assert!(r.get_f64("rim_tets") > 0.0);
+}
+
+#[test]
+fn static_experiments_pass_and_are_thread_independent() {
+    let mut p = presets::fvm_vs_nodal();
+    p.finest = t(&p.finest, 16);
+    let r = assert_thread_independent("fvm-vs-nodal", || tiny(&p, ex::fvm_vs_nodal::run));
+    assert_checks_pass("fvm-vs-nodal", &r);
+    let mut p = presets::surface_mixed_radii();
+    p.finest = t(&p.finest, 32);
+    let r = assert_thread_independent("surface-mixed-radii", || tiny(&p, ex::surface_mixed_radii::run));
+    assert!(r.get_f64("flat_patch_vertices") > 0.0);
+}
+
+#[test]
+fn splash_and_corridor_are_thread_independent() {
+    let mut p = presets::open_splash();
+    (p.finest, p.duration) = (t(&p.finest, 16), t(&p.duration, 0.05));
+    assert_thread_independent("open-splash", || tiny(&p, ex::open_splash::run));
+    let mut p = presets::corridor_camera();
+    (p.finest, p.duration) = (t(&p.finest, 16), t(&p.duration, 0.05));
+    assert_thread_independent("corridor-camera", || tiny(&p, ex::corridor_camera::run));
+}
