@@ -25,7 +25,8 @@ pub mod wind_flag;
 
 /// The `params` block of a scene file (`scenes/shells/<scene>.ron`, whose top level is
 /// `(method: …, description: …, params: (…))`) as an experiment's `Params`; an unreadable file
-/// or a bad field is an error naming the file and the parser's line and column.
+/// or a bad field is an error naming the file and the parser's line and column. Optional fields
+/// are written without `Some(…)` (RON's `implicit_some`, as `cargo xtask` reads scene files).
 ///
 /// ```no_run
 /// use geom_core::experiment::Size;
@@ -48,6 +49,8 @@ pub fn scene_params<P: serde::de::DeserializeOwned>(path: &std::path::Path) -> c
     let name = path.display();
     let text = std::fs::read_to_string(path)
         .map_err(|e| crate::Error::BadParameter(format!("{name}: cannot read the scene file: {e}")))?;
-    let f: File<P> = ron::from_str(&text).map_err(|e| crate::Error::BadParameter(format!("{name}: {e}")))?;
+    // Scene files write optional fields without `Some(…)`, as xtask reads them.
+    let opts = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let f: File<P> = opts.from_str(&text).map_err(|e| crate::Error::BadParameter(format!("{name}: {e}")))?;
     Ok(f.params)
 }
