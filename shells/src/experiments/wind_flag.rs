@@ -82,7 +82,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         steps += 1;
         let st = sim.state();
         // Sampled once per frame, after its last step.
-        if steps % substeps == 0 && st.t >= settle {
+        if steps.is_multiple_of(substeps) && st.t >= settle {
             tip_z.push(st.q[tip].z);
             drag.push(metrics::wind_drag(&wf, &faces, &st.q, &st.v, st.t, &dir));
         }
