@@ -78,7 +78,7 @@ pub fn runners() -> Vec<Runner> {
     let mut v = Vec::new();
     crate::crates::geom_core::register(&mut v);
     crate::crates::barnet::register(&mut v);
-    crate::scenes::shells::register(&mut v);
+    crate::crates::shells::register(&mut v);
     crate::scenes::tracks::register(&mut v);
     crate::scenes::tracks_variants::register(&mut v);
     crate::crates::curve_skin::register(&mut v);

@@ -20,6 +20,7 @@ pub mod geom_core;
 pub mod motion_graph;
 pub mod perf_control;
 pub mod rigging;
+pub mod shells;
 pub mod wrinkles;
 
 /// An experiment of a method crate: `run(&Params, Size, &mut dyn Recorder)`.

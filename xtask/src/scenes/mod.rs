@@ -1,5 +1,4 @@
 //! Scene runners, one module per crate. Each module's `register` adds its runners.
 
-pub mod shells;
 pub mod tracks;
 pub mod tracks_variants;
