@@ -2,8 +2,8 @@
 //! 12-free-node arm net and grid membranes, and one whole arm frame.
 
 use barnet::analytic;
-use barnet::deformer::{BarNetDeformer, DeformerConfig, Drivers, FineSpec, FrameOutput, NodeSet};
-use barnet::subdiv::Scheme;
+use barnet::deformer::{BarNetDeformer, Drivers, FrameOutput};
+use barnet::presets::biceps_arm;
 use barnet::{FdmOptions, FdmSolver};
 use criterion::{criterion_group, criterion_main, Criterion};
 use geom_core::math::Iso3;
@@ -18,18 +18,7 @@ fn bench(c: &mut Criterion) {
         let s = FdmSolver::new(&case.net, &FdmOptions::default()).expect("valid net");
         c.bench_function(&format!("membrane_{n}x{n}_solve"), |b| b.iter(|| s.solve(&loads, &fixed).expect("finite")));
     }
-    let cfg = DeformerConfig {
-        arm: Default::default(),
-        ramp_half_width: 0.04,
-        free: NodeSet::Named("biceps_triceps_12".into()),
-        q: 1.0,
-        groups: vec![],
-        loads: vec![],
-        stiffness: vec![],
-        fine: FineSpec::Subdivision { scheme: Scheme::CatmullClark, levels: 2 },
-        max_disp: None,
-    };
-    let mut d = BarNetDeformer::new(&cfg).expect("valid arm");
+    let mut d = BarNetDeformer::new(&biceps_arm()).expect("valid arm");
     let pose = d.arm_pose(1.5, &Iso3::identity()).expect("pose");
     let drv = Drivers { joint_angles: vec![0.0, 1.5, 0.0], time: 0.0 };
     let mut out = FrameOutput::default();

@@ -56,6 +56,16 @@ pub enum BarNetError {
     /// A parameter outside its valid range, or an unknown name.
     #[error("bar-net: invalid parameter: {0}")]
     InvalidParameter(String),
+    /// A frame whose equilibrium residual exceeds the bound an experiment asserts (spec §7.3 e).
+    #[error("{what}: equilibrium residual {residual:e} exceeds {bound:e} (spec 7.3 e)")]
+    Residual {
+        /// The experiment.
+        what: &'static str,
+        /// The relative residual ‖D x − (P − D_f x_f)‖ / ‖P − D_f x_f‖.
+        residual: f64,
+        /// The bound.
+        bound: f64,
+    },
 }
 
 /// Result alias of the crate.

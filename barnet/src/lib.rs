@@ -13,15 +13,20 @@
 //! - [`analytic`]: cable and membrane nets with exact solutions (§7.1).
 //! - [`subdiv`], [`wrap`]: the fine skin from the control mesh (§3.4.4).
 //! - [`skin`], [`arm`], [`patch`], [`deformer`]: the character coupling (§3.4–3.6, §3.8).
+//! - [`presets`]: the paper's biceps arm and its bar-net; [`metrics`]: every figure the scenes
+//!   report; [`experiments`]: the reproduction scenes of spec §6 as library calls.
 
 pub mod analytic;
 pub mod arm;
 pub mod assemble;
 pub mod deformer;
 pub mod error;
+pub mod experiments;
+pub mod metrics;
 pub mod net;
 pub mod nonlinear;
 pub mod patch;
+pub mod presets;
 pub mod skin;
 pub mod solver;
 pub mod subdiv;

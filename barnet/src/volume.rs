@@ -3,7 +3,8 @@
 
 use crate::error::Result;
 use crate::topo::PolyTopo;
-use geom_core::math::AsPt3;
+use geom_core::graph::Ragged;
+use geom_core::math::{AsPt3, Pt3};
 use geom_core::mesh::{signed_volume_capped, PolyMesh, Topology};
 
 /// Precomputed fan triangulation of a polygon mesh and its geom-core topology.
@@ -19,6 +20,13 @@ impl CappedVolume {
     pub fn new(m: &PolyMesh) -> Result<Self> {
         let (tris, topo) = PolyTopo::triangle_topology(m)?;
         Ok(Self { tris, topo })
+    }
+
+    /// Prepares the measurement for meshes with these polygon faces (positions do not matter
+    /// here: only the connectivity is analysed).
+    pub fn for_faces(faces: &Ragged<u32>) -> Result<Self> {
+        let n = faces.items.iter().map(|&v| v as usize + 1).max().unwrap_or(0);
+        Self::new(&PolyMesh { positions: vec![Pt3::origin(); n], faces: faces.clone(), uv: None })
     }
 
     /// Signed volume (divergence theorem, f64 sums) of the capped surface for positions `p`:

@@ -3,11 +3,8 @@
 
 use barnet::analytic::{self, NetCase};
 use barnet::assemble::d_from_branch_node;
-use barnet::deformer::{
-    BarNetDeformer, DeformerConfig, DirLocal, DriverSpec, Drivers, FineSpec, FrameOutput, LoadSpec, NodeSet,
-};
+use barnet::deformer::{BarNetDeformer, DeformerConfig, Drivers, FrameOutput, LoadSpec};
 use barnet::net::{Bar, BarNet};
-use barnet::subdiv::Scheme;
 use barnet::{FdmOptions, FdmSolver, SolverPath};
 use geom_core::math::{Iso3, Pt3, Vec3};
 use geom_core::rng::Rng;
@@ -213,28 +210,11 @@ fn stiffness_change_has_a_global_effect() {
 // 7.3 coupling
 
 fn arm_config(loads: Vec<LoadSpec>, q: f64) -> DeformerConfig {
-    DeformerConfig {
-        arm: Default::default(),
-        ramp_half_width: 0.04,
-        free: NodeSet::Named("biceps_triceps_12".into()),
-        q,
-        groups: vec![],
-        loads,
-        stiffness: vec![],
-        fine: FineSpec::Subdivision { scheme: Scheme::CatmullClark, levels: 2 },
-        max_disp: None,
-    }
+    DeformerConfig { loads, q, ..barnet::presets::biceps_arm() }
 }
 
 fn biceps_load() -> LoadSpec {
-    LoadSpec {
-        name: "biceps_bulge".into(),
-        nodes: NodeSet::Named("biceps_mid".into()),
-        dir_local: DirLocal::Radial,
-        driver: DriverSpec::JointAngle { joint: "elbow".into() },
-        curve: vec![(0.0, 0.0), (1.57, 0.6), (2.4, 1.0)],
-        scale: 0.02,
-    }
+    barnet::presets::biceps_bulge()
 }
 
 /// 7.3 a, b: rest pose reproduced; rigid motion ⇒ rigid, with and without channels.

@@ -1,27 +1,18 @@
 //! Spec §7.5 (nonlinear reference) and §7.6 (the paper's claim about mass–spring nets).
 
 use barnet::analytic;
-use barnet::arm::{Arm, ArmSpec};
+use barnet::metrics::{contraction_ratios, convergence_order};
 use barnet::net::BarNet;
 use barnet::nonlinear::{form_find_nonlinear, Elastic, NewtonOptions, NonlinearModel};
+use barnet::presets;
 use barnet::{FdmOptions, FdmSolver};
 use geom_core::math::{Pt3, Vec3};
+use geom_core::stats;
 
 /// The 12-free-node arm net with its rest positions split by kind.
 fn arm_net() -> (BarNet, Vec<Pt3>, Vec<Pt3>, Vec<f64>) {
-    let arm = Arm::new(&ArmSpec::default()).unwrap();
-    let free_list = arm.named("biceps_triceps_12").unwrap();
-    let mut free = vec![false; arm.mesh.positions.len()];
-    for v in free_list {
-        free[v as usize] = true;
-    }
-    let net = BarNet::from_mesh_edges(&arm.mesh, &free, 1.0).unwrap();
-    let (fr, fx, _) = net.index_maps();
-    let xf: Vec<Pt3> = fr.iter().map(|&v| arm.mesh.positions[v as usize]).collect();
-    let xs: Vec<Pt3> = fx.iter().map(|&v| arm.mesh.positions[v as usize]).collect();
-    let len =
-        net.bars.iter().map(|b| (arm.mesh.positions[b.a as usize] - arm.mesh.positions[b.b as usize]).norm()).collect();
-    (net, xf, xs, len)
+    let a = presets::arm_net().unwrap();
+    (a.net, a.free, a.fixed, a.bar_len)
 }
 
 /// 7.5 a: Schek's nonlinear FDM reaches q_j l_j = s_j and equilibrium.
@@ -47,7 +38,7 @@ fn prescribed_forces_fixed_point() {
     )
     .unwrap();
     assert!(r.converged, "history {:?}", r.history);
-    // q_j l_j = s_j at the converged shape, and the linear FDM with those q is in equilibrium.
+    // 7.5 a: q_j l_j = s_j at the converged shape and equilibrium holds (1e-10).
     let (_, _, index) = c.net.index_maps();
     let pos = |v: u32| {
         if c.net.fixed[v as usize] {
@@ -56,22 +47,41 @@ fn prescribed_forces_fixed_point() {
             r.x[index[v as usize] as usize]
         }
     };
-    let mut net = c.net.clone();
-    for b in &mut net.bars {
-        let l = (pos(b.a) - pos(b.b)).norm();
-        b.q = 1.0 / l;
+    // Force balance at every free node with bar forces of exactly s_j along the converged bars:
+    // p_i + Σ_j s_j (x_k − x_i)/|x_k − x_i| = 0 (computed here, not through the solver).
+    let mut force = vec![Vec3::zeros(); r.x.len()];
+    for (b, &sj) in c.net.bars.iter().zip(&s) {
+        let d = pos(b.b) - pos(b.a);
+        let f = d * (sj / d.norm());
+        if !c.net.fixed[b.a as usize] {
+            force[index[b.a as usize] as usize] += f;
+        }
+        if !c.net.fixed[b.b as usize] {
+            force[index[b.b as usize] as usize] -= f;
+        }
     }
-    for b in &net.bars {
-        let l = (pos(b.a) - pos(b.b)).norm();
-        assert!((b.q * l - 1.0).abs() < 1e-10);
+    let imbalance = stats::max(&force.iter().zip(&loads).map(|(f, p)| (f + p).norm()).collect::<Vec<_>>());
+    assert!(imbalance < 1e-10, "force imbalance {imbalance:e} (bar forces s = 1)");
+    // The same equilibrium as the linear FDM with q_j = s_j / l_j at the converged shape.
+    let mut net = c.net.clone();
+    for (b, &sj) in net.bars.iter_mut().zip(&s) {
+        b.q = sj / (pos(b.a) - pos(b.b)).norm();
     }
     let solver = FdmSolver::new(&net, &FdmOptions::default()).unwrap();
     let res = solver.residual(&r.x, &loads, &fixed).unwrap();
     assert!(res < 1e-10, "equilibrium residual {res}");
-    // 7.5 d: linear convergence with a roughly constant contraction ratio < 1.
+    // 7.5 d: linear convergence with a constant contraction ratio < 1, measured on the second
+    // half of the history: the fitted order is 1 and the ratio settles to a constant (measured:
+    // order 1.0000, ratios 0.9179 … 0.9181 over 83 iterations).
     let h = &r.history;
-    let ratios: Vec<f64> = h.windows(2).skip(2).take(5).map(|w| w[1] / w[0]).collect();
-    assert!(ratios.iter().all(|&q| q < 1.0), "contraction ratios {ratios:?}");
+    let ratios = contraction_ratios(h);
+    let tail = &ratios[ratios.len() / 2..];
+    let (lo, hi) = (stats::min(tail), stats::max(tail));
+    let order = convergence_order(&h[h.len() / 2..], 1e-15);
+    eprintln!("7.5 d: {} iterations, tail ratios in [{lo}, {hi}], order {order}", h.len());
+    assert!(tail.len() >= 10, "too short a tail to measure: {h:?}");
+    assert!(hi < 1.0 && hi - lo < 0.01 * hi, "contraction ratio not constant: [{lo}, {hi}]");
+    assert!((order - 1.0).abs() < 0.01, "not linear: fitted order {order}");
 }
 
 /// 7.5 b: gradient and Hessian against central differences; quadratic Newton tail.
@@ -108,14 +118,14 @@ fn elastic_bars_derivatives_and_newton() {
     let model = NonlinearModel::ElasticBars { k: k.clone(), rest_len: l0.clone() };
     let r = form_find_nonlinear(&net, &model, &loads, &xs, &xf, &NewtonOptions::default()).unwrap();
     assert!(r.converged && r.iterations <= 15, "iterations {} history {:?}", r.iterations, r.history);
+    // The order of convergence, measured: the fitted exponent of ‖∇E_{k+1}‖ ≈ C‖∇E_k‖ᵖ over the
+    // iterations after the first (line search) above the rounding floor is 2 for Newton (measured
+    // 1.93 on 1.5e-2 … 6.5e-14); a linearly converging method gives 1, which the old test
+    // (‖∇E_{k+1}‖/‖∇E_k‖² < 1e4 while ‖∇E_k‖ > 1e-9) let through for ratios ≤ 0.5.
     let h = &r.history;
-    let n = h.len();
-    assert!(n >= 3);
-    for w in h[n.saturating_sub(4)..].windows(2) {
-        if w[0] > 1e-9 {
-            assert!(w[1] / (w[0] * w[0]) < 1e4, "not quadratic: {h:?}");
-        }
-    }
+    let order = convergence_order(&h[1..], 1e-15);
+    eprintln!("7.5 b: gradient norms {h:?}, fitted order {order}");
+    assert!(order > 1.8, "not quadratic: fitted order {order}, history {h:?}");
 }
 
 /// 7.5 c: zero load and L0 = rest lengths ⇒ the rest state in 0 iterations.

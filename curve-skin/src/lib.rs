@@ -12,17 +12,22 @@
 //! Modules: [`weights`] (packed K-influence weights), [`skinner`] (the common trait and parallel
 //! driver), [`lbs`], [`dq`] + [`dqs`], [`curve`] (curve skeleton, frames, binding, tables),
 //! [`metrics`], [`procedural`] (cylinder arm, capsule humanoid), [`poses`] (test poses, walk
-//! cycle), [`gltf`] (glTF 2.0 export of a skinned mesh).
+//! cycle), [`gltf`] (glTF 2.0 export of a skinned mesh), [`presets`] (the reference arm, the
+//! capsule character and the standard skinners), [`reference`] (closed forms), [`experiments`]
+//! (the reproduction scenes of spec §6 as library calls).
 
 pub mod curve;
 pub mod dq;
 pub mod dqs;
 pub mod error;
+pub mod experiments;
 pub mod gltf;
 pub mod lbs;
 pub mod metrics;
 pub mod poses;
+pub mod presets;
 pub mod procedural;
+pub mod reference;
 pub mod skinner;
 pub mod weights;
 

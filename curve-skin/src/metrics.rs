@@ -1,8 +1,13 @@
 //! Skinning quality metrics (spec §2.4, §7): enclosed volume, joint / ring radius ratios,
-//! distance to the posed bones, fold fraction of a deformation map, influence histograms.
+//! distance to the posed bones, fold fraction of a deformation map, influence histograms, and
+//! the vertex error against a reference deformation.
+//!
+//! Every extremum propagates NaN (`geom_core::stats::nan_min` / `nan_max`): a deformation that
+//! produced a NaN vertex reports NaN, never the extremum of the remaining vertices.
 
 use geom_core::math::{AsPt3, Pt3, Vec3};
 use geom_core::query::closest_point_segment;
+use geom_core::stats::{nan_max, nan_min};
 
 /// Signed volume enclosed by a closed, outward-oriented triangle mesh (divergence theorem,
 /// accumulated in `f64`; positive for outward faces): `geom_core::mesh::signed_volume`, which
@@ -29,7 +34,7 @@ pub fn joint_radius_ratio<P: AsPt3, Q: AsPt3>(
         let r = r.pt3();
         let d0 = (r - joint_rest).norm();
         if d0 <= lim && d0 >= 0.5 * radius {
-            best = best.min((p.pt3() - joint_posed).norm());
+            best = nan_min(best, (p.pt3() - joint_posed).norm());
         }
     }
     if best.is_finite() {
@@ -60,7 +65,7 @@ pub fn ring_radius_ratio<P: AsPt3, Q: AsPt3>(
             continue;
         }
         let d = p.pt3() - origin;
-        best = best.min((d - a * d.dot(&a)).norm());
+        best = nan_min(best, (d - a * d.dot(&a)).norm());
     }
     if best.is_finite() {
         best / radius
@@ -76,17 +81,46 @@ pub fn self_intersections<P: AsPt3>(pos: &[P], tris: &[[u32; 3]]) -> usize {
     geom_core::query::count_self_intersections(tris, pos)
 }
 
-/// Minimum and maximum over `pos` of the distance to the nearest posed bone segment.
+/// Minimum and maximum over `pos` of the distance to the nearest posed bone segment (m); NaN
+/// when a position is NaN.
 pub fn distance_to_bones<P: AsPt3>(pos: &[P], bones: &[(Pt3, Pt3)]) -> (f64, f64) {
     let mut lo = f64::INFINITY;
     let mut hi: f64 = 0.0;
     for p in pos {
         let p = p.pt3();
-        let d = bones.iter().map(|(a, b)| (closest_point_segment(&p, a, b).1 - p).norm()).fold(f64::INFINITY, f64::min);
-        lo = lo.min(d);
-        hi = hi.max(d);
+        let d = bones.iter().map(|(a, b)| (closest_point_segment(&p, a, b).1 - p).norm()).fold(f64::INFINITY, nan_min);
+        lo = nan_min(lo, d);
+        hi = nan_max(hi, d);
     }
     (lo, hi)
+}
+
+/// Largest and root-mean-square distance (m) between corresponding points of `a` and `b` (a
+/// deformation against its reference); NaN if any distance is NaN, `(0, 0)` for empty input.
+pub fn max_rms_error(a: &[Pt3], b: &[Pt3]) -> (f64, f64) {
+    let mut mx: f64 = 0.0;
+    let mut s = 0.0;
+    for (x, y) in a.iter().zip(b) {
+        let d = (x - y).norm();
+        mx = nan_max(mx, d);
+        s += d * d;
+    }
+    (mx, (s / a.len().max(1) as f64).sqrt())
+}
+
+/// `f32` positions (the skinners' output) as `f64` points.
+pub fn to_f64(p: &[[f32; 3]]) -> Vec<Pt3> {
+    p.iter().map(|x| Pt3::new(x[0] as f64, x[1] as f64, x[2] as f64)).collect()
+}
+
+/// Histogram of sparse weight-row sizes, the last bin holding every row of `cap` or more entries
+/// (`h[k]` = rows with `k` influences).
+pub fn rows_histogram(rows: &[Vec<(u16, f32)>], cap: usize) -> Vec<usize> {
+    let mut h = vec![0usize; cap + 1];
+    for r in rows {
+        h[r.len().min(cap)] += 1;
+    }
+    h
 }
 
 /// Fraction of `samples` where the deformation `map` folds: `det J ≤ 0`, J by central

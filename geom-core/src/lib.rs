@@ -15,6 +15,7 @@ pub mod cluster;
 pub mod collide;
 pub mod error;
 pub mod experiment;
+pub mod experiments;
 pub mod graph;
 pub mod image;
 pub mod io;

@@ -1,8 +1,9 @@
 //! PNG round trips and filter invariants.
 
 use geom_core::image::{
-    convolve_separable, gaussian_blur, read_png, read_png_rgb, write_png_gray16, write_png_gray8, write_png_mask,
-    write_png_rgb8, Border, ImageF32, ImageRgbF32, Mask,
+    convolve_separable, encode_png_gray16, encode_png_gray8, encode_png_mask, encode_png_rgb8, gaussian_blur, read_png,
+    read_png_rgb, write_png_gray16, write_png_gray8, write_png_mask, write_png_rgb8, Border, ImageF32, ImageRgbF32,
+    Mask,
 };
 use geom_core::rng::Rng;
 use geom_core::Error;
@@ -54,6 +55,27 @@ fn gray16_round_trip() {
     let grid_q: Vec<f32> = grid.data.iter().map(|&v| ((v as f64 * 65535.0).round() / 65535.0) as f32).collect();
     write_png_gray16(&path, &grid, 65535.0).expect("write");
     assert_eq!(read_png(&path).expect("read").data, grid_q);
+}
+
+/// The in-memory encoders produce exactly the bytes the file writers write.
+#[test]
+fn encoders_match_the_files() {
+    let mut rng = Rng::new(4);
+    let img = random_image(&mut rng, 11, 6);
+    let rgb = ImageRgbF32::from_data(3, 2, (0..6).map(|i| [i as f32 / 6.0, 0.5, 1.0]).collect()).expect("sizes");
+    let mut m = Mask::new(4, 2, false);
+    m.set(2, 1, true);
+    let (p8, p16, prgb, pm) = (tmp("e8.png"), tmp("e16.png"), tmp("ergb.png"), tmp("em.png"));
+    write_png_gray8(&p8, &img).expect("write");
+    write_png_gray16(&p16, &img, 1000.0).expect("write");
+    write_png_rgb8(&prgb, &rgb).expect("write");
+    write_png_mask(&pm, &m).expect("write");
+    let read = |p: &std::path::Path| std::fs::read(p).expect("read back");
+    assert_eq!(encode_png_gray8(&img).expect("encode"), read(&p8));
+    assert_eq!(encode_png_gray16(&img, 1000.0).expect("encode"), read(&p16));
+    assert_eq!(encode_png_rgb8(&rgb).expect("encode"), read(&prgb));
+    assert_eq!(encode_png_mask(&m).expect("encode"), read(&pm));
+    assert!(encode_png_gray8(&ImageF32::new(0, 3, 0.0)).is_err(), "empty images are errors");
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! The example database (spec §3.2): takes (synchronized control/target recordings with a
 //! segmentation), cut into instances resampled at the working rate, plus the per-point weights.
 
+use crate::dance::grammar::{DanceLabel, Half, Stance, Transition};
 use crate::error::{check_finite, PcError, Result};
 use crate::track::{prefilter, PointTrack};
 use geom_core::anim::Motion;
@@ -23,8 +24,35 @@ pub enum SegmentLabel {
         /// The foot planted at the start of the step.
         lead_foot: Side,
     },
+    /// One two-beat segment of a partner dance (spec §3.13): the dance label (stance before the
+    /// transition, transition, half, handhold toggle) and the index of its 8-beat pattern in the
+    /// take.
+    Dance {
+        /// Stance before the transition.
+        stance: Stance,
+        /// The 4-beat transition.
+        transition: Transition,
+        /// Which 2-beat half.
+        half: Half,
+        /// Handhold toggle at the end of the transition (half `B` only).
+        toggle: bool,
+        /// Index of the 8-beat pattern in its take.
+        pattern: u16,
+    },
     /// No label.
     None,
+}
+
+impl SegmentLabel {
+    /// The dance label of a [`SegmentLabel::Dance`] (without the pattern index), else `None`.
+    pub fn dance(&self) -> Option<DanceLabel> {
+        match *self {
+            SegmentLabel::Dance { stance, transition, half, toggle, .. } => {
+                Some(DanceLabel { stance, transition, half, toggle })
+            }
+            _ => None,
+        }
+    }
 }
 
 /// One recorded example performance.

@@ -12,7 +12,11 @@
 //! alignment), [`db`] (takes, instances, database), [`reduce`] (complete-linkage reduction),
 //! [`cell`] (one DP cell), [`dp`] (the DP, beam, forced segments), [`refine`] (upsampling
 //! refinement), [`output`] (target construction, post-processing, skeletal output), [`control`]
-//! (control builders), [`eval`] (metrics), [`data`] (procedural walks and mouse paths).
+//! (control builders), [`eval`] (metrics, walk and dance), [`data`] (procedural walks, mouse paths
+//! and the partner-dance duet), [`dance`] (the dance grammar), [`handhold`] (handhold propagation
+//! and closing, §3.11), [`stream`] (fixed-lag streaming DP, §13),
+//! [`pipeline`] (the end-to-end call [`drive`]), [`presets`] (the paper's databases) and
+//! [`experiments`] (the paper's experiments, callable without xtask).
 //!
 //! Conventions: metres, seconds, Y up, planar transforms = geom-core's [`geom_core::math::Planar`];
 //! frames at the working rate unless stated; shared boundary samples between consecutive
@@ -20,15 +24,22 @@
 
 pub mod align;
 pub mod cell;
+pub mod clock;
 pub mod control;
+pub mod dance;
 pub mod data;
 pub mod db;
 pub mod dp;
 pub mod error;
 pub mod eval;
+pub mod experiments;
+pub mod handhold;
 pub mod output;
+pub mod pipeline;
+pub mod presets;
 pub mod reduce;
 pub mod refine;
+pub mod stream;
 pub mod track;
 
 pub use align::{align, Alignment};
@@ -41,6 +52,8 @@ pub use output::{
     achieved_control, placed_motions, placed_segments, postprocess_segments, propagate, target_motion, target_points,
     Signal,
 };
+pub use pipeline::{drive, drive_points, Driven, DrivenPoints};
+pub use presets::PreparedDb;
 pub use reduce::{ClusterBy, ClusterDistance, ClusterOptions, ClusterReport, Representative};
 pub use refine::refine;
 pub use track::PointTrack;

@@ -11,7 +11,7 @@
 //! ```no_run
 //! use rigging::character::{rig_character, CharacterOptions};
 //! use rigging::SkeletonTemplate;
-//! let m = geom_core::io::read_any("hero.obj").unwrap();
+//! let (m, _) = geom_core::io::read_any("hero.obj").unwrap().triangulate_fan().unwrap();
 //! let r = rig_character(&m.positions, &m.faces, &SkeletonTemplate::human(), &CharacterOptions::default()).unwrap();
 //! println!("{} ({}): {} joints", r.orientation, if r.rig.discrete.certified_optimal { "optimal" } else { "budget" }, r.joints.len());
 //! ```

@@ -121,7 +121,7 @@ pub fn measure(size: f64, ell: f64, rotated: bool, r: f64, sphere: bool) -> Resu
     let q = if sphere { wrap_sphere(&p, r) } else { wrap_cylinder(&p, r) };
     let d = interior_energy_density(&mesh, &q, 1.5 * ell);
     let ratio = d * r * r;
-    let ideal = if sphere { 4.0 } else { 3.0 };
+    let ideal = if sphere { crate::reference::SPHERE_DENSITY } else { crate::reference::CYLINDER_DENSITY };
     Ok(CalibResult { ratio, rel_err: (ratio / ideal - 1.0).abs() })
 }
 

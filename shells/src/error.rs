@@ -30,6 +30,17 @@ pub enum Error {
         /// What was detected.
         reason: String,
     },
+    /// A scene's run stopped at a failed step (`message`: that step's error); the frames
+    /// recorded before it stay recorded.
+    #[error("{scene} failed after {steps} steps (frames kept): {message}")]
+    RunFailed {
+        /// The scene.
+        scene: String,
+        /// Steps completed.
+        steps: u64,
+        /// The failed step's error.
+        message: String,
+    },
     /// An error of the geometry core (mesh validation, solver, I/O).
     #[error(transparent)]
     Core(#[from] geom_core::Error),

@@ -8,6 +8,10 @@
 //! Cholesky of geom-core, and collisions after Bridson, Fedkiw & Anderson 2002.
 //!
 //! Units are SI (m, kg, s), angles in radians, y is up in the scenes.
+//!
+//! The scenes of `cargo xtask run shells/<scene>` are public experiments here
+//! ([`experiments`]), with the materials and setups they use ([`presets`]), the figures they
+//! report ([`metrics`]) and the analytic solutions they are compared with ([`reference`]).
 
 // `!(x > 0.0)` is used on purpose throughout: it rejects NaN together with the invalid range.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -24,9 +28,12 @@ pub mod error;
 pub mod experiments;
 pub mod integrator;
 pub mod kernels;
+pub mod loads;
 pub mod material;
 pub mod mesh;
 pub mod metrics;
+pub mod presets;
+pub mod reference;
 pub mod scene;
 pub mod sim;
 pub mod wind;

@@ -31,17 +31,6 @@ impl Material {
         b / 6.0
     }
 
-    /// The "cotton" preset of §4 (ρ 0.15, Yt 2000, ν 0.3, k_B 5e-6, β 1e-4).
-    pub fn cotton() -> Self {
-        Self {
-            density: 0.15,
-            membrane: MembraneLaw::Isotropic { young_thickness: 2000.0, poisson: 0.3, compression_softening: None },
-            bending: 5e-6,
-            damping: Damping::Rayleigh { alpha: 0.0, beta: 1e-4 },
-            plasticity: None,
-        }
-    }
-
     /// Checks every parameter (finite, in range); errors name the parameter and its value.
     pub fn validate(&self) -> Result<()> {
         let bad = |s: String| Err(Error::BadParameter(s));

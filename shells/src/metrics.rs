@@ -1,6 +1,12 @@
-//! Physical-sanity figures of a cloth simulation, computed after every step (not only on
-//! written frames): the invariants that expose a simulation that is not cloth — edges stretched
-//! or crushed, vertices inside obstacles, energy from nowhere, NaN.
+//! Every figure a `shells` scene reports.
+//!
+//! [`Sanity`]: the physical-sanity figures of a cloth simulation, computed after every step (not
+//! only on written frames): the invariants that expose a simulation that is not cloth — edges
+//! stretched or crushed, vertices inside obstacles, energy from nowhere, NaN. Beside it, the
+//! scene figures: the accuracy error of the benchmark ([`rms_distance_rel`]), the crease
+//! measurements of plastic-crease ([`max_abs_change`], [`extreme_ratio`], [`max_abs`],
+//! [`segment_angle`], [`relative_spread`]), the wind drag ([`wind_drag`]), the pile height
+//! ([`height_span`]) and the passive-scene test of `energy_gain_rel` ([`is_passive`]).
 //!
 //! Every figure is NaN-safe: a NaN anywhere makes it NaN (written as `null`), never 0.
 //!
@@ -14,11 +20,13 @@
 //! assert!((s.max_edge_strain - 0.1).abs() < 1e-12);
 //! ```
 
-use geom_core::math::Pt3;
+use geom_core::math::{Pt3, Vec3};
 use geom_core::stats::nan_max;
 
 use crate::collision::obstacles::{mesh_query, PlacedObstacle};
 use crate::effects::Obstacle;
+use crate::sim::{ShellSceneDesc, VertexConstraint};
+use crate::wind::WindField;
 
 /// Running sanity figures of one simulation.
 #[derive(Clone, Debug)]
@@ -104,6 +112,82 @@ impl Sanity {
     }
 }
 
+/// True for a passive scene, where `energy_gain_rel` is defined (issue 20): gravity, static pins
+/// and static obstacles only — no wind, no user force, no kinematic vertices, no moving
+/// obstacle.
+pub fn is_passive(desc: &ShellSceneDesc) -> bool {
+    desc.effects.gravity.is_some_and(|g| g.norm() > 0.0)
+        && desc.effects.wind.is_none()
+        && desc.effects.custom.is_empty()
+        && desc.effects.obstacles.iter().all(|o| o.motion.is_none())
+        && desc.constraints.iter().all(|c| matches!(c, VertexConstraint::Pinned(_)))
+}
+
+/// The accuracy error of the benchmark (shells.md §9): mass-weighted RMS distance between the
+/// positions `a` and the reference `b` (m), over the bounding-box diagonal of `b`
+/// (dimensionless; the diagonal is taken as 1 m for an empty mesh).
+pub fn rms_distance_rel(a: &[Pt3], b: &[Pt3], mass: &[f64]) -> f64 {
+    let mt: f64 = mass.iter().sum();
+    let rms = (a.iter().zip(b).zip(mass).map(|((x, y), w)| w * (x - y).norm_squared()).sum::<f64>() / mt).sqrt();
+    let diag = geom_core::mesh::bbox_of(b).map(|(lo, hi)| (hi - lo).norm()).unwrap_or(1.0);
+    rms / diag
+}
+
+/// max_i |a_i − b_i| (0 for empty slices, NaN if any difference is NaN): plastic-crease's
+/// per-hinge crease max|θ̄ − θ̄₀| (rad).
+pub fn max_abs_change(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, nan_max)
+}
+
+/// max_i |a_i| (0 for an empty slice, NaN if any is NaN).
+pub fn max_abs(a: &[f64]) -> f64 {
+    a.iter().map(|x| x.abs()).fold(0.0, nan_max)
+}
+
+/// The ratio a_i/b_i farthest from 1 (1 for empty slices, NaN if any ratio is NaN): the
+/// hardening of plastic-crease's hinge stiffnesses k/k₀.
+pub fn extreme_ratio(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x / y).fold(1.0, |m: f64, r| {
+        if m.is_nan() || r.is_nan() {
+            f64::NAN
+        } else if (r - 1.0).abs() > (m - 1.0).abs() {
+            r
+        } else {
+            m
+        }
+    })
+}
+
+/// The angle between two segment directions (rad, in [0, π]), atan2(|d₀ × d₁|, d₀·d₁).
+pub fn segment_angle(d0: &Vec3, d1: &Vec3) -> f64 {
+    d0.cross(d1).norm().atan2(d0.dot(d1))
+}
+
+/// (max − min)/mean of a sample (NaN if any is NaN or the sample is empty; the mean is floored
+/// at 1e-300): the step-size spread of plastic-crease.
+pub fn relative_spread(v: &[f64]) -> f64 {
+    use geom_core::stats::{max, mean, min};
+    (max(v) - min(v)) / mean(v).max(1e-300)
+}
+
+/// Highest minus lowest y (m) of the positions (NaN for none or a NaN coordinate).
+pub fn height_span(q: &[Pt3]) -> f64 {
+    let y: Vec<f64> = q.iter().map(|p| p.y).collect();
+    geom_core::stats::max(&y) - geom_core::stats::min(&y)
+}
+
+/// The wind force on the cloth (N) along the unit direction `dir`: Σ over triangles of the
+/// drag [`WindField::triangle`] gives per vertex (three vertices share it equally), at time `t`.
+pub fn wind_drag(wind: &WindField, faces: &[[u32; 3]], q: &[Pt3], v: &[Vec3], t: f64, dir: &Vec3) -> f64 {
+    let mut f = Vec3::zeros();
+    for tri in faces {
+        let x = tri.map(|i| q[i as usize]);
+        let vv = tri.map(|i| v[i as usize]);
+        f += 3.0 * wind.triangle(&x, &vv, t).0;
+    }
+    f.dot(dir)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -165,5 +249,30 @@ mod tests {
         s.observe(&rest, 9.0, Some(f64::NAN));
         assert!(s.energy_gain_rel().unwrap().is_nan());
         assert!(Sanity::new(&rest, &e, Vec::new(), None).energy_gain_rel().is_none());
+    }
+
+    #[test]
+    fn scene_figures_propagate_nan() {
+        assert_eq!(max_abs_change(&[1.0, 2.0], &[1.5, 0.5]), 1.5);
+        assert!(max_abs_change(&[1.0, f64::NAN], &[0.0, 0.0]).is_nan());
+        assert!(max_abs(&[f64::NAN, 1.0]).is_nan());
+        assert_eq!(extreme_ratio(&[1.1, 0.5, 3.0], &[1.0, 1.0, 1.0]), 3.0);
+        assert_eq!(extreme_ratio(&[0.5], &[1.0]), 0.5);
+        assert!(extreme_ratio(&[f64::NAN, 3.0], &[1.0, 1.0]).is_nan());
+        assert!(extreme_ratio(&[3.0, f64::NAN], &[1.0, 1.0]).is_nan());
+        assert!((relative_spread(&[1.0, 2.0, 3.0]) - 1.0).abs() < 1e-15);
+        assert!(relative_spread(&[1.0, f64::NAN]).is_nan());
+        assert!(height_span(&[Pt3::origin(), Pt3::new(0.0, f64::NAN, 0.0)]).is_nan());
+        assert_eq!(height_span(&[Pt3::origin(), Pt3::new(5.0, -2.0, 0.0)]), 2.0);
+        let a = segment_angle(&Vec3::x(), &Vec3::new(-1.0, 1.0, 0.0));
+        assert!((a - 0.75 * std::f64::consts::PI).abs() < 1e-15);
+    }
+
+    #[test]
+    fn rms_distance_is_mass_weighted_and_relative() {
+        let b = vec![Pt3::origin(), Pt3::new(3.0, 4.0, 0.0)];
+        let a = vec![Pt3::new(1.0, 0.0, 0.0), Pt3::new(3.0, 4.0, 0.0)];
+        // √(3·1/4) / 5
+        assert!((rms_distance_rel(&a, &b, &[3.0, 1.0]) - 0.75f64.sqrt() / 5.0).abs() < 1e-15);
     }
 }

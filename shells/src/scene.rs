@@ -364,13 +364,18 @@ impl ShellScene {
         let n = pos.len() as u32;
         let mut pinned: Vec<u32> = Vec::new();
         for (k, p) in self.pins.iter().enumerate() {
-            pinned.extend(select(p, dims, &pos).map_err(|m| Error::BadParameter(format!("pins[{k}]: {m}")))?);
+            let ids = select(p, dims, &pos).map_err(|m| Error::BadParameter(format!("pins[{k}]: {m}")))?;
+            // An empty set is a mistake (a wrong radius, an empty list), never an intent.
+            if ids.is_empty() {
+                return Err(Error::BadParameter(format!("pins[{k}] selects no vertex")));
+            }
+            if let Some(&bad) = ids.iter().find(|&&i| i >= n) {
+                return Err(Error::BadParameter(format!("pins[{k}]: vertex {bad} out of range ({n} vertices)")));
+            }
+            pinned.extend(ids);
         }
         pinned.sort_unstable();
         pinned.dedup();
-        if let Some(&bad) = pinned.iter().find(|&&i| i >= n) {
-            return Err(Error::BadParameter(format!("pins: vertex {bad} out of range ({n} vertices)")));
-        }
         let mut constraints =
             if pinned.is_empty() { Vec::new() } else { vec![VertexConstraint::Pinned(pinned.clone())] };
         let mut taken: std::collections::BTreeSet<u32> = pinned.iter().copied().collect();

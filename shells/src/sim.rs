@@ -841,6 +841,7 @@ impl ShellSim {
             let mut trial = v_cur.to_vec();
             let mut accepted = false;
             let mut phi = phi0;
+            let a_full = a == 1.0;
             for _ in 0..30 {
                 for (fidx, &vtx) in free.iter().enumerate() {
                     let i = vtx as usize;
@@ -861,6 +862,26 @@ impl ShellSim {
             }
             v_cur.copy_from_slice(&trial);
             phi_cur = Some(phi);
+            // Away from contact, the seed's integrator: when no pair is within d̂ at this iterate
+            // or at the step's end, no friction is lagged, and neither CCD nor the line search
+            // shortened the step, barrier and friction are zero and the `newton_iters`
+            // linearised steps of the contact-free integrator (one by default, seed §4.3) are
+            // accepted as they are.
+            if accepted
+                && a_full
+                && a == 1.0
+                && contacts.is_empty()
+                && st.contact.friction == 0
+                && st.newton_iters >= self.settings.newton_iters
+            {
+                let xe: Vec<Pt3> = q_base.iter().zip(v_cur.iter()).map(|(p, v)| p + h_eff * v).collect();
+                if ipc.contacts(&xe).is_empty() {
+                    st.contact.contact_free_steps += 1;
+                    converged = true;
+                    st.t_collision += tl.elapsed().as_secs_f64();
+                    break;
+                }
+            }
             if std::env::var_os("SHELLS_IPC_DEBUG").is_some() {
                 eprintln!(
                     "  iter {}: |dv| {dv_max:.3e} alpha {a:.3e} contacts {} phi0 {phi0:.6e}",

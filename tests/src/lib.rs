@@ -2,6 +2,7 @@
 //! library only holds helpers they share.
 
 use geom_core::experiment::{Report, Value};
+use serde::de::DeserializeOwned;
 
 /// Runs `f` inside a rayon pool of `threads` threads.
 pub fn with_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
@@ -46,4 +47,24 @@ pub fn assert_checks_pass(name: &str, r: &Report) {
         .map(|c| format!("{} = {} (target {}; {})", c.key, c.value, c.target.describe(), c.source))
         .collect();
     assert!(failed.is_empty(), "{name}: failed checks:\n  {}", failed.join("\n  "));
+}
+
+/// The `params` block of the built-in scene `scenes/<id>.ron` (e.g. `"curve-skin/elbow-bend"`)
+/// as the experiment's `Params`: the tests run exactly the scenes `cargo xtask` runs, at
+/// `Size::Tiny`. Panics with the file and the parse error (line, column) when it does not parse.
+pub fn scene_params<P: DeserializeOwned>(id: &str) -> P {
+    #[derive(serde::Deserialize)]
+    struct Envelope<P> {
+        #[allow(dead_code)]
+        method: String,
+        #[allow(dead_code)]
+        #[serde(default)]
+        description: String,
+        params: P,
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes").join(format!("{id}.ron"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let opts = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let env: Envelope<P> = opts.from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    env.params
 }

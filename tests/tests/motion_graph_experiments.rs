@@ -18,7 +18,7 @@ fn root() -> PathBuf {
 fn scene(name: &str) -> search::Params {
     let mut p: search::Params =
         load_params(&root().join("scenes/motion-graph").join(format!("{name}.ron"))).unwrap_or_else(|e| panic!("{e}"));
-    p.resolve_paths(&root());
+    p.resolve_paths(&root().join("scenes/motion-graph"));
     p
 }
 

@@ -8,6 +8,10 @@
 //! frame [`WrinkleAnimator::frame`] (deformation measures, [`modulation`] factors, [`blend`]
 //! weights, [`smoothing`]) → output surfaces ([`displaced`] mesh, bump normals, area report).
 //!
+//! Reproduction: [`presets`] (sheets, patterns, prescribed deformations), [`metrics`] (every
+//! figure of the scenes), [`reference`] (the 1-D buckled strip) and [`experiments`] (the scenes of
+//! spec §6 as library calls).
+//!
 //! Conventions: SI units (m); rest local frame per triangle with edge 0 as x axis (spec §3.3);
 //! equation numbers refer to the spec's reconstructed §3 (the paper's own equations are not in
 //! the seed).
@@ -17,10 +21,14 @@ pub mod blend;
 pub mod coeffs;
 pub mod displaced;
 pub mod error;
+pub mod experiments;
 pub mod frames;
+pub mod metrics;
 pub mod modulation;
 pub mod pattern;
+pub mod presets;
 pub mod quadrature;
+pub mod reference;
 pub mod smoothing;
 
 pub use animator::{

@@ -77,10 +77,7 @@ fn t5_linearisation_second_order() {
         let res = (wrinkled_area(&c.grad_samples, &cc, h) - c.area_wrinkled).abs() / c.area_wrinkled;
         pts.push((d.ln(), res.ln()));
     }
-    let n = pts.len() as f64;
-    let (mx, my) = (pts.iter().map(|p| p.0).sum::<f64>() / n, pts.iter().map(|p| p.1).sum::<f64>() / n);
-    let slope =
-        pts.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>() / pts.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
+    let slope = geom_core::stats::linear_fit(&pts).1;
     assert!((slope - 2.0).abs() < 0.1, "slope {slope}: {pts:?}");
 }
 

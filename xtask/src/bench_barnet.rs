@@ -13,45 +13,25 @@
 use std::time::Instant;
 
 use barnet::analytic;
-use barnet::deformer::{
-    BarNetDeformer, DeformerConfig, DirLocal, DriverSpec, Drivers, FineSpec, FrameOutput, LoadSpec, NodeSet,
-};
+use barnet::deformer::{BarNetDeformer, DeformerConfig, Drivers, FineSpec, FrameOutput};
+use barnet::metrics::max_distance;
+use barnet::presets::{biceps_arm, biceps_bulge};
 use barnet::subdiv::{self, Scheme};
 use barnet::{FdmOptions, FdmSolver};
-use geom_core::math::{Iso3, Pt3};
+use geom_core::math::Iso3;
+use geom_core::stats::{median, nan_max};
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::out::{CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
 use crate::registry::BenchCtx;
 
-fn bn(e: barnet::BarNetError) -> Error {
-    Error::Run(format!("barnet: {e}"))
-}
-
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
+/// The paper's biceps arm with its bulge channel, skinned at Catmull–Clark level `levels`.
 fn arm_config(levels: u32) -> DeformerConfig {
     DeformerConfig {
-        arm: Default::default(),
-        ramp_half_width: 0.04,
-        free: NodeSet::Named("biceps_triceps_12".into()),
-        q: 1.0,
-        groups: vec![],
-        loads: vec![LoadSpec {
-            name: "biceps_bulge".into(),
-            nodes: NodeSet::Named("biceps_mid".into()),
-            dir_local: DirLocal::Radial,
-            driver: DriverSpec::JointAngle { joint: "elbow".into() },
-            curve: vec![(0.0, 0.0), (1.57, 0.6), (2.4, 1.0)],
-            scale: 0.02,
-        }],
-        stiffness: vec![],
+        loads: vec![biceps_bulge()],
         fine: FineSpec::Subdivision { scheme: Scheme::CatmullClark, levels },
-        max_disp: None,
+        ..biceps_arm()
     }
 }
 
@@ -70,19 +50,19 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
         let c = analytic::membrane(n, 1.0);
         let (loads, fixed) = c.split();
         let t0 = Instant::now();
-        let solver = FdmSolver::new(&c.net, &FdmOptions::default()).map_err(bn)?;
+        let solver = FdmSolver::new(&c.net, &FdmOptions::default())?;
         let tf = t0.elapsed().as_secs_f64();
         let mut x = Vec::new();
         let mut times = Vec::new();
         let mut res = 0.0;
         for _ in 0..5 {
             let t = Instant::now();
-            res = solver.solve_into(&loads, &fixed, &mut x).map_err(bn)?.rel_residual;
+            res = solver.solve_into(&loads, &fixed, &mut x)?.rel_residual;
             times.push(t.elapsed().as_secs_f64());
         }
-        let tsol = median(times);
+        let tsol = median(&times);
         let err = analytic::max_abs_err(&x, c.exact.as_ref().expect("membrane has an exact solution"), 2);
-        max_res = max_res.max(res);
+        max_res = nan_max(max_res, res);
         pts.push((tsol, err));
         fpts.push((tf, err));
         csv.row(&[n.into(), loads.len().into(), err.into(), res.into(), tf.into(), tsol.into()])?;
@@ -98,30 +78,26 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
         .with(Series::new("factorisation", fpts))
         .write_png(&ctx.out_dir.join("accuracy_vs_time.png"))?;
     // 2. Fine-mesh resolution on the arm.
-    let arm = barnet::arm::Arm::new(&Default::default()).map_err(bn)?;
+    let arm = barnet::arm::Arm::new(&Default::default())?;
     let max_level = if ctx.quick { 3 } else { 4 };
-    let (reference, _) = subdiv::catmull_clark(&arm.mesh, max_level).map_err(bn)?;
+    let (reference, _) = subdiv::catmull_clark(&arm.mesh, max_level)?;
     let mut csv =
         CsvWriter::create(&ctx.out_dir.join("fine_levels.csv"), &["level", "fine_vertices", "geom_err_m", "frame_s"])?;
     let mut lpts = Vec::new();
     for level in 0..max_level {
-        let (fine, _) = subdiv::catmull_clark(&arm.mesh, level).map_err(bn)?;
-        let err = fine
-            .positions
-            .iter()
-            .zip(&reference.positions)
-            .map(|(a, b): (&Pt3, &Pt3)| (a - b).norm())
-            .fold(0.0, f64::max);
-        let mut d = BarNetDeformer::new(&arm_config(level)).map_err(bn)?;
-        let pose = d.arm_pose(1.5, &Iso3::identity()).map_err(bn)?;
+        let (fine, _) = subdiv::catmull_clark(&arm.mesh, level)?;
+        // Coarse vertices keep their indices across levels: compare the common prefix.
+        let err = max_distance(&fine.positions, &reference.positions);
+        let mut d = BarNetDeformer::new(&arm_config(level))?;
+        let pose = d.arm_pose(1.5, &Iso3::identity())?;
         let drv = Drivers { joint_angles: vec![0.0, 1.5, 0.0], time: 0.0 };
         let mut out = FrameOutput::default();
         let mut times = Vec::new();
         for _ in 0..21 {
-            d.deform(&pose, &drv, &mut out).map_err(bn)?;
+            d.deform(&pose, &drv, &mut out)?;
             times.push(out.timings.total);
         }
-        let t = median(times);
+        let t = median(&times);
         lpts.push((t, err));
         csv.row(&[(level as usize).into(), fine.positions.len().into(), err.into(), t.into()])?;
         if level == 2 {

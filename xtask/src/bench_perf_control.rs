@@ -7,71 +7,25 @@
 //!   RMS with refinement on, and the coarse-only tracking RMS (refinement off);
 //! - `cluster`: database size (all, 140, 100, 70, 50, 35), both distance modes: time vs error;
 //! - `stretch`: stretch limit 0 … 0.3 s: time (P grows) vs error;
-//! - `k`: continuity constant 0 … 100: tracking error and seam jumps (quality only).
+//! - `k`: continuity constant 0 … 100: tracking error and seam jumps (quality only);
+//! - `dance`: the dance rows — beam width w ∈ {0, 0.1, 0.3, 1, 3, 10, ∞} on the PC-4 database and
+//!   first test dance: DP wall and CPU time vs score excess and two-beat error rate, and whether
+//!   the labels equal the exact run's (`pc_dance.csv`, `pc_dance.png`;
+//!   [`perf_control::experiments::sweeps::evaluate_dance`]).
 //!
-//! Writes `pc_<sweep>.csv` and `pc_<sweep>.png` per sweep.
+//! Every point is one call of [`perf_control::experiments::sweeps::evaluate`]. Writes
+//! `pc_<sweep>.csv` and `pc_<sweep>.png` per sweep.
 
-use std::time::Instant;
-
-use perf_control::data::walk::HIP_WIDTH;
-use perf_control::data::{walk_motion, walk_take};
-use perf_control::eval::seam_jumps;
-use perf_control::{
-    achieved_control, hips_control, interpret, refine, target_motion, target_points, tracking_error, ClusterBy,
-    ClusterDistance, ClusterOptions, DpParams, MappingDb, PointTrack, Representative, Take,
-};
+use perf_control::experiments::sweeps::{evaluate, evaluate_dance, DanceSweep, SweepPoint, WalkSweep};
+use perf_control::{ClusterDistance, DpParams};
 
 use crate::error::{Error, Result};
-use crate::out::{CsvWriter, Summary};
+use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
 use crate::registry::BenchCtx;
 
 /// The sweeps `--sweep` accepts.
-pub const SWEEPS: &[&str] = &["beam", "rate", "cluster", "stretch", "k"];
-
-fn pc<T>(r: perf_control::Result<T>) -> Result<T> {
-    r.map_err(|e| Error::Run(format!("perf-control: {e}")))
-}
-
-struct Setup {
-    take: Take,
-    x_fine: PointTrack,
-    quick: bool,
-}
-
-/// What one evaluation measured.
-struct Eval {
-    /// DP wall time (s).
-    dp_s: f64,
-    /// DP score `S` (m²).
-    score: f64,
-    /// Tracking RMS after refinement and skeletal output (m).
-    rms: f64,
-    /// Tracking RMS of the coarse placed control, refinement off (m).
-    coarse_rms: f64,
-    /// Largest raw seam jump of the target points, before blending (m).
-    jump: f64,
-    /// DP columns `P`.
-    columns: usize,
-}
-
-impl Eval {
-    /// Writes one CSV row (the columns of `HEADER`).
-    fn row(&self, csv: &mut CsvWriter, sweep: &str, value: f64, mode: &str, excess: f64) -> Result<()> {
-        csv.row(&[
-            sweep.into(),
-            value.into(),
-            mode.into(),
-            self.dp_s.into(),
-            self.score.into(),
-            excess.into(),
-            self.rms.into(),
-            self.coarse_rms.into(),
-            self.jump.into(),
-            self.columns.into(),
-        ])
-    }
-}
+pub const SWEEPS: &[&str] = &["beam", "rate", "cluster", "stretch", "k", "dance"];
 
 /// The CSV columns of every sweep.
 const HEADER: [&str; 10] = [
@@ -87,42 +41,26 @@ const HEADER: [&str; 10] = [
     "columns",
 ];
 
-/// One evaluation: database reduced to `size` at `factor` (working rate 30/factor Hz), DP with `p`,
-/// refinement to 30 Hz and skeletal output.
-fn evaluate(s: &Setup, factor: usize, size: Option<usize>, mode: ClusterDistance, p: &DpParams) -> Result<Eval> {
-    let mut db = pc(MappingDb::from_takes(vec![s.take.clone()], 30.0 / factor as f64))?;
-    if let Some(n) = size.filter(|&n| n < db.instances.len()) {
-        pc(db.cluster(&ClusterOptions {
-            by: ClusterBy::TargetSize(n),
-            distance: mode,
-            stretch_limit_s: p.stretch_limit_s,
-            representative: Representative::Random,
-            seed: 11,
-        }))?;
-    }
-    let x = s.x_fine.downsample(factor);
-    let t0 = Instant::now();
-    let it = pc(interpret(&db, &x, p))?;
-    let dp_s = t0.elapsed().as_secs_f64();
-    let coarse_rms = tracking_error(&x, &pc(achieved_control(&db, &it))?).rms_m;
-    let fine_db = pc(db.at_rate(30.0))?;
-    let fine = if factor > 1 { pc(refine(&fine_db, &s.x_fine, &it, factor, p))? } else { it.clone() };
-    let out = pc(target_motion(&fine_db, &fine, true))?;
-    let rms = tracking_error(&s.x_fine, &hips_control(&out, HIP_WIDTH)).rms_m;
-    let pts = pc(target_points(&fine_db, &fine, false))?;
-    let seams: Vec<usize> = fine.segments[1..].iter().filter(|c| c.start > 0).map(|c| c.start as usize).collect();
-    let jump = seam_jumps(&pts, &seams).0.into_iter().fold(0.0, f64::max);
-    Ok(Eval { dp_s, score: it.score, rms, coarse_rms, jump, columns: it.stats.columns })
+/// Writes one CSV row (the columns of `HEADER`).
+fn row(csv: &mut CsvWriter, r: &SweepPoint, sweep: &str, value: f64, mode: &str, excess: f64) -> Result<()> {
+    csv.row(&[
+        sweep.into(),
+        value.into(),
+        mode.into(),
+        r.dp_s.into(),
+        r.score.into(),
+        excess.into(),
+        r.rms.into(),
+        r.coarse_rms.into(),
+        r.jump.into(),
+        r.columns.into(),
+    ])
 }
 
 /// Runs the selected sweeps.
 pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     let quick = ctx.quick;
-    let s = Setup {
-        take: walk_take(11, if quick { 40.0 } else { 120.0 }, 30.0),
-        x_fine: hips_control(&walk_motion(301, if quick { 20.0 } else { 57.0 }, 30.0), HIP_WIDTH),
-        quick,
-    };
+    let s = WalkSweep::new(quick);
     let sel: Vec<&str> = match ctx.sweep.as_deref() {
         None | Some("all") => SWEEPS.to_vec(),
         Some(x) if SWEEPS.contains(&x) => vec![x],
@@ -130,11 +68,18 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     };
     let mut summary = Summary::new();
     summary.set_str("mode", if quick { "quick" } else { "default" });
+    let cat = ClusterDistance::ControlAndTarget;
     for sw in sel {
+        if sw == "dance" {
+            dance(ctx, &mut summary)?;
+            summary.set_count("dance_done", 1);
+            continue;
+        }
         let mut csv = CsvWriter::create(&ctx.out_dir.join(format!("pc_{sw}.csv")), &HEADER)?;
         // The walk defaults of spec §4 (k = 10, ±0.2 s, exact, partial ends); PC-1's database size.
         let p0 = DpParams::default();
-        let size = if s.quick { 40 } else { 70 };
+        let beam = DpParams { beam: Some(0.3), ..p0.clone() };
+        let size = s.db_size();
         let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
         let mut add = |label: &str, pt: (f64, f64)| {
             if let Some(e) = series.iter_mut().find(|e| e.0 == label) {
@@ -145,14 +90,12 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
         };
         let (x_label, y_label) = match sw {
             "beam" => {
-                let exact = evaluate(&s, 3, Some(size), ClusterDistance::ControlAndTarget, &p0)?;
+                let exact = evaluate(&s, 3, Some(size), cat, &p0)?;
                 let mut chosen = f64::INFINITY;
                 for w in [0.0, 0.01, 0.03, 0.1, 0.3, 1.0, 3.0, f64::INFINITY] {
-                    let mut p = p0.clone();
-                    p.beam = Some(w);
-                    let r = evaluate(&s, 3, Some(size), ClusterDistance::ControlAndTarget, &p)?;
+                    let r = evaluate(&s, 3, Some(size), cat, &DpParams { beam: Some(w), ..p0.clone() })?;
                     let excess = (r.score - exact.score) / exact.score;
-                    r.row(&mut csv, "beam", w, "", excess)?;
+                    row(&mut csv, &r, "beam", w, "", excess)?;
                     add("beam widths", (r.dp_s, excess.max(1e-9)));
                     if excess <= 0.01 && (r.rms - exact.rms).abs() <= 1e-3 && w < chosen {
                         chosen = w;
@@ -167,10 +110,8 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                     if s.quick && f == 1 {
                         continue;
                     }
-                    let mut p = p0.clone();
-                    p.beam = Some(0.3);
-                    let r = evaluate(&s, f, Some(size), ClusterDistance::ControlAndTarget, &p)?;
-                    r.row(&mut csv, "rate", hz, "beam0.3", f64::NAN)?;
+                    let r = evaluate(&s, f, Some(size), cat, &beam)?;
+                    row(&mut csv, &r, "rate", hz, "beam0.3", f64::NAN)?;
                     add("refined (30 Hz skeleton)", (r.dp_s, r.rms));
                     add("coarse placed control", (r.dp_s, r.coarse_rms));
                 }
@@ -184,11 +125,9 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 };
                 for mode in [ClusterDistance::ControlAndTarget, ClusterDistance::ControlOnly] {
                     for &n in &sizes {
-                        let mut p = p0.clone();
-                        p.beam = Some(0.3);
-                        let r = evaluate(&s, 3, n, mode, &p)?;
+                        let r = evaluate(&s, 3, n, mode, &beam)?;
                         let v = n.map_or(f64::NAN, |n| n as f64);
-                        r.row(&mut csv, "cluster", v, &format!("{mode:?}"), f64::NAN)?;
+                        row(&mut csv, &r, "cluster", v, &format!("{mode:?}"), f64::NAN)?;
                         add(&format!("{mode:?}"), (r.dp_s, r.rms));
                     }
                 }
@@ -196,22 +135,16 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             }
             "stretch" => {
                 for lim in [0.0, 0.1, 0.15, 0.2, 0.3] {
-                    let mut p = p0.clone();
-                    p.stretch_limit_s = lim;
-                    p.beam = Some(0.3);
-                    let r = evaluate(&s, 3, Some(size), ClusterDistance::ControlAndTarget, &p)?;
-                    r.row(&mut csv, "stretch", lim, "beam0.3", f64::NAN)?;
+                    let r = evaluate(&s, 3, Some(size), cat, &DpParams { stretch_limit_s: lim, ..beam.clone() })?;
+                    row(&mut csv, &r, "stretch", lim, "beam0.3", f64::NAN)?;
                     add("stretch limits", (r.dp_s, r.rms));
                 }
                 ("DP time (s)", "tracking RMS (m)")
             }
             _ => {
                 for k in [0.0, 1.0, 3.0, 10.0, 30.0, 100.0] {
-                    let mut p = p0.clone();
-                    p.k = k;
-                    p.beam = Some(0.3);
-                    let r = evaluate(&s, 3, Some(size), ClusterDistance::ControlAndTarget, &p)?;
-                    r.row(&mut csv, "k", k, "beam0.3", f64::NAN)?;
+                    let r = evaluate(&s, 3, Some(size), cat, &DpParams { k, ..beam.clone() })?;
+                    row(&mut csv, &r, "k", k, "beam0.3", f64::NAN)?;
                     add("tracking RMS (m)", (k, r.rms));
                     add("max raw seam jump (m)", (k, r.jump));
                 }
@@ -229,4 +162,46 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
         summary.set_count(&format!("{sw}_done"), 1);
     }
     Ok(summary)
+}
+
+/// The dance rows (spec §9): beam widths on the PC-4 database and first test dance.
+fn dance(ctx: &BenchCtx, summary: &mut Summary) -> Result<()> {
+    let s = DanceSweep::new(ctx.quick)?;
+    let header = [
+        "w",
+        "dp_s",
+        "dp_cpu_s",
+        "score",
+        "score_excess_rel",
+        "two_beat_error_rate",
+        "labels_as_exact",
+        "cells_expanded",
+    ];
+    let mut csv = CsvWriter::create(&ctx.out_dir.join("pc_dance.csv"), &header)?;
+    let p0 = DpParams { stretch_limit_s: 0.15, ..DpParams::default() };
+    let exact = evaluate_dance(&s, &p0)?;
+    let (mut wall, mut cpu) = (Vec::new(), Vec::new());
+    for w in [0.0, 0.1, 0.3, 1.0, 3.0, 10.0, f64::INFINITY] {
+        let r = evaluate_dance(&s, &DpParams { beam: Some(w), ..p0.clone() })?;
+        let excess = (r.score - exact.score) / exact.score;
+        csv.row(&[
+            w.into(),
+            r.dp_s.into(),
+            r.dp_cpu_s.into(),
+            r.score.into(),
+            excess.into(),
+            r.two_beat_error_rate.into(),
+            Cell::Int(i64::from(r.labels == exact.labels)),
+            Cell::Int(r.cells_expanded as i64),
+        ])?;
+        wall.push((r.dp_s, excess.max(1e-9)));
+        cpu.push((r.dp_cpu_s, excess.max(1e-9)));
+    }
+    summary.set("dance_exact_two_beat_error_rate", exact.two_beat_error_rate);
+    LinePlot::new("perf-control: dance beam sweep", "DP time (s)", "relative score excess (floored at 1e-9)")
+        .log(false, true)
+        .with(Series::new("wall", wall))
+        .with(Series::new("CPU", cpu))
+        .write_png(&ctx.out_dir.join("pc_dance.png"))?;
+    Ok(())
 }

@@ -4,47 +4,17 @@
 //! measures the integrator) and `wind-flag`, each against a fine reference of the same scene
 //! (16× the default substeps, 20 Newton iterations with line search, ProjectedEigen). Error: mass-
 //! weighted RMS vertex distance at the end time over the bounding-box diagonal. Writes
-//! `accuracy.csv`, `accuracy.png` (error vs ms/frame) and the summary.
+//! `accuracy.csv`, `accuracy.png` (error vs ms/frame) and the summary. The runs, the reference
+//! and the error are `shells::experiments::accuracy` and `shells::metrics`.
 
-use std::time::Instant;
-
-use geom_core::math::Pt3;
+use shells::experiments::{accuracy, drape, wind_flag};
 use shells::scene::{MeshSpec, ShellScene};
-use shells::{HessianMode, ShellSim};
+use shells::HessianMode;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
 use crate::registry::BenchCtx;
-use crate::scenes::shells::{DrapeParams, WindParams};
-
-fn err(e: shells::Error) -> Error {
-    Error::Run(format!("shells: {e}"))
-}
-
-/// Simulates `shell` for `duration` seconds; returns (final positions, masses, ms per frame,
-/// regularisations).
-fn simulate(shell: &ShellScene, duration: f64) -> Result<(Vec<Pt3>, Vec<f64>, f64, u32)> {
-    let b = shell.build(&crate::out::workspace_root()).map_err(err)?;
-    let mut sim = ShellSim::new(b.desc).map_err(err)?;
-    let h = shell.integrator.h();
-    let frames = (duration * shell.integrator.fps).round() as usize;
-    let mut regs = 0;
-    let t0 = Instant::now();
-    for _ in 0..frames * shell.integrator.substeps as usize {
-        let st = sim.step(h).map_err(err)?;
-        regs += (st.regularization_shift > 0.0) as u32;
-    }
-    let ms = 1e3 * t0.elapsed().as_secs_f64() / frames.max(1) as f64;
-    Ok((sim.state().q.clone(), sim.mesh().mass.clone(), ms, regs))
-}
-
-fn error(a: &[Pt3], b: &[Pt3], m: &[f64]) -> f64 {
-    let mt: f64 = m.iter().sum();
-    let rms = (a.iter().zip(b).zip(m).map(|((x, y), w)| w * (x - y).norm_squared()).sum::<f64>() / mt).sqrt();
-    let diag = geom_core::mesh::bbox_of(b).map(|(lo, hi)| (hi - lo).norm()).unwrap_or(1.0);
-    rms / diag
-}
 
 fn set_grid(s: &mut ShellScene, nx: u32, ny: u32) {
     if let MeshSpec::Grid { nx: a, ny: b, .. } = &mut s.mesh {
@@ -56,8 +26,8 @@ fn set_grid(s: &mut ShellScene, nx: u32, ny: u32) {
 /// The benchmark entry point.
 pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     let dir = crate::scene::scenes_dir().join("shells");
-    let drape: DrapeParams = crate::scene::load(&dir.join("drape.ron"))?.params;
-    let wind: WindParams = crate::scene::load(&dir.join("wind-flag.ron"))?.params;
+    let drape: drape::Params = crate::scene::load(&dir.join("drape.ron"))?.params;
+    let wind: wind_flag::Params = crate::scene::load(&dir.join("wind-flag.ron"))?.params;
     let mut d = drape.shell.clone();
     d.effects.collision = None;
     d.effects.self_collision = false;
@@ -78,37 +48,28 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     let mut s = Summary::new();
     let mut plot = LinePlot::new("shells: error vs cost", "ms per frame", "RMS error / bbox diagonal").log(true, true);
     for (name, base) in [("drape", d), ("wind-flag", w)] {
-        let mut reference = base.clone();
-        reference.integrator.substeps = base.integrator.substeps * if ctx.quick { 4 } else { 16 };
-        reference.integrator.newton_iters = 20;
-        reference.integrator.line_search = true;
-        reference.integrator.hessian = HessianMode::ProjectedEigen;
-        let (qr, m, ms_ref, _) = simulate(&reference, duration)?;
-        s.set(&format!("{name}_reference_ms_per_frame"), ms_ref);
+        let fine = accuracy::simulate(&accuracy::reference(&base, if ctx.quick { 4 } else { 16 }), duration)?;
+        s.set(&format!("{name}_reference_ms_per_frame"), fine.ms_per_frame);
         let mut best: Option<(f64, f64, String)> = None;
         for mode in [HessianMode::ProjectedCheap, HessianMode::ProjectedEigen] {
             for &it in &iters {
                 let mut pts = Vec::new();
                 for &sub in &subs {
-                    let mut c = base.clone();
-                    c.integrator.substeps = sub;
-                    c.integrator.newton_iters = it;
-                    c.integrator.hessian = mode;
-                    let (q, _, ms, regs) = simulate(&c, duration)?;
-                    let e = error(&q, &qr, &m);
+                    let r = accuracy::simulate(&accuracy::configured(&base, sub, it, mode), duration)?;
+                    let e = shells::metrics::rms_distance_rel(&r.q, &fine.q, &fine.mass);
                     csv.row(&[
                         Cell::Text(name.into()),
                         Cell::Int(sub as i64),
                         Cell::Int(it as i64),
                         Cell::Text(format!("{mode:?}")),
-                        Cell::Num(ms),
+                        Cell::Num(r.ms_per_frame),
                         Cell::Num(e),
-                        Cell::Int(regs as i64),
+                        Cell::Int(r.regularizations as i64),
                     ])?;
-                    pts.push((ms, e));
+                    pts.push((r.ms_per_frame, e));
                     // Cheapest configuration within 1e-2 error.
-                    if e < 1e-2 && best.as_ref().is_none_or(|b| ms < b.0) {
-                        best = Some((ms, e, format!("{mode:?} x{it} substeps {sub}")));
+                    if e < 1e-2 && best.as_ref().is_none_or(|b| r.ms_per_frame < b.0) {
+                        best = Some((r.ms_per_frame, e, format!("{mode:?} x{it} substeps {sub}")));
                     }
                 }
                 plot = plot.with(Series::new(format!("{name} {mode:?} newton {it}"), pts));

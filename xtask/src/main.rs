@@ -6,6 +6,7 @@
 mod ui;
 
 mod bench_barnet;
+mod bench_cloth_fit;
 mod bench_curve_skin;
 mod bench_flip_tet;
 mod bench_geom_core;
@@ -34,7 +35,6 @@ mod ronpath;
 mod run;
 mod scene;
 mod scene_items;
-mod scenes;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -32,7 +32,6 @@ impl RunCtx {
     /// stay as they are): `Obj(path: "mygrid.obj")` in `/home/u/shot.ron` is
     /// `/home/u/mygrid.obj`, wherever the command runs from. Built-in scenes reach the shipped
     /// assets as `../../assets/…`.
-    #[allow(dead_code)] // called by the crates' adapters as they move onto `run_experiment` (issue 21)
     pub fn resolve(&self, path: impl AsRef<Path>) -> PathBuf {
         crate::paths::resolve_in(&self.scene_file, path.as_ref())
     }
@@ -77,16 +76,17 @@ pub struct Bench {
 /// Every scene runner of every crate.
 pub fn runners() -> Vec<Runner> {
     let mut v = Vec::new();
-    crate::scenes::geom_core::register(&mut v);
-    crate::scenes::barnet::register(&mut v);
-    crate::scenes::shells::register(&mut v);
+    crate::crates::geom_core::register(&mut v);
+    crate::crates::barnet::register(&mut v);
+    crate::crates::shells::register(&mut v);
     crate::crates::tracks::register(&mut v);
-    crate::scenes::curve_skin::register(&mut v);
+    crate::crates::curve_skin::register(&mut v);
     crate::crates::rigging::register(&mut v);
     crate::crates::motion_graph::register(&mut v);
-    crate::scenes::perf_control::register(&mut v);
+    crate::crates::perf_control::register(&mut v);
     crate::crates::flip_tet::register(&mut v);
-    crate::scenes::wrinkles::register(&mut v);
+    crate::crates::wrinkles::register(&mut v);
+    crate::crates::cloth_fit::register(&mut v);
     v
 }
 
@@ -152,6 +152,12 @@ pub fn benches() -> Vec<Bench> {
             description: "wrinkles: quadrature tolerance, gradient bins, mode, smoothing and subdivision level vs coefficient/h/area error and time",
             run: crate::bench_wrinkles::run,
             sweeps: &[],
+        },
+        Bench {
+            crate_name: "cloth-fit",
+            description: "cloth-fit: annealing budget, coarse search, mesh and image resolution, dt vs parameter error and wall time; evaluation cost by stage; anytime curve",
+            run: crate::bench_cloth_fit::run,
+            sweeps: crate::bench_cloth_fit::SWEEPS,
         },
     ]
 }

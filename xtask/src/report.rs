@@ -313,6 +313,7 @@ pub fn write_markdown(report_dir: &Path, runs: &[RunInfo], wall_s: Option<f64>) 
             let _ = writeln!(md, "![{name}]({})\n", relative(report_dir, &img));
         }
     }
+    crate::out::ensure_dir(report_dir)?;
     let path = report_dir.join("index.md");
     std::fs::write(&path, md).map_err(io_err(&path))?;
     Ok(path)

@@ -223,21 +223,6 @@ fn generic_outputs(dir: &Path, summary: &mut Summary, enabled: bool) -> Result<f
     Ok(dt)
 }
 
-/// Runs a scene file with its runner into `out_dir` as the tests do (the tool's own folder,
-/// cleared first; no previews) and returns the figures of its `summary.json`.
-#[cfg(test)]
-pub fn run_scene(scene_id: &str, file: &Path, mode: Mode, out_dir: &Path) -> Result<Summary> {
-    let o = RunOptions {
-        mode,
-        out_dir: out_dir.to_path_buf(),
-        policy: DirPolicy::Owned,
-        overrides: Vec::new(),
-        previews: false,
-        label: scene_id.to_string(),
-    };
-    run_scene_with(scene_id, file, &o).map(|r| r.summary)
-}
-
 /// Runs a scene file with its runner into `o.out_dir`; writes `summary.json` (with `wall_s` and
 /// `mode` added, last and atomically) and returns it. A failure leaves `FAILED` in the folder.
 pub fn run_scene_with(scene_id: &str, file: &Path, o: &RunOptions) -> Result<RunResult> {

@@ -206,7 +206,7 @@ pub fn apply_overrides(file: &Path, text: &str, overrides: &[Override]) -> Resul
                     .map(|(k, e)| (k, Some(e)))
                     .unwrap_or((0, None));
                 let (line, col) = e.map(|e| ronpath::line_col(&text, e.key_at)).unwrap_or((1, 1));
-                let have = ronpath::path_string(&path[..k]);
+                let have = display_path(&path[..k]);
                 return Err(Error::Scene {
                     file: file.to_path_buf(),
                     line,
@@ -249,6 +249,15 @@ fn spanned(path: &Path, text: &str, overrides: &[Override], e: ron::error::Spann
     let o = ronpath::outline(text);
     let entry = ronpath::innermost(&o, at).filter(|e| !e.path.is_empty());
     let mut msg = explain(&e.code);
+    // ron reads `4.5` where an integer is expected as the integer 4 followed by a stray `.5`
+    // ("Expected comma"): say what is wrong with the value.
+    let fraction = text.get(at..).is_some_and(|r| {
+        let mut c = r.chars();
+        c.next() == Some('.') && c.next().is_some_and(|d| d.is_ascii_digit())
+    }) && text.get(..at).and_then(|l| l.chars().last()).is_some_and(|d| d.is_ascii_digit());
+    if fraction {
+        msg = "expected an integer, found a number with a fraction".into();
+    }
     if let Some(e) = entry {
         msg = format!("`{}`: {msg}", display_path(&e.path));
         // A value that came from the command line: say so.

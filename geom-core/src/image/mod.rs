@@ -16,5 +16,6 @@ pub use apng::{encode_apng, write_apng};
 pub use buffers::{Border, ImageF32, ImageRgbF32, Mask};
 pub use filter::{convolve_separable, gaussian_blur, gaussian_kernel};
 pub use png_io::{
-    png_gray8_bytes, read_png, read_png_rgb, write_png_gray16, write_png_gray8, write_png_mask, write_png_rgb8,
+    encode_png_gray16, encode_png_gray8, encode_png_mask, encode_png_rgb8, png_gray8_bytes, read_png, read_png_rgb,
+    write_png_gray16, write_png_gray8, write_png_mask, write_png_rgb8,
 };

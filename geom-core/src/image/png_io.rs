@@ -1,7 +1,7 @@
 //! PNG reading and writing through the `png` crate.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter};
+use std::io::{BufReader, BufWriter, Write};
 use std::path::Path;
 
 use super::buffers::{luminance, ImageF32, ImageRgbF32, Mask};
@@ -20,6 +20,27 @@ fn quantize(v: f32, max: f64) -> u32 {
     (v as f64 * max).round().clamp(0.0, max) as u32
 }
 
+/// Encodes samples as PNG into `w`; `what` names the destination in errors.
+fn encode_into(
+    w: impl Write,
+    what: &Path,
+    width: u32,
+    height: u32,
+    color: png::ColorType,
+    depth: png::BitDepth,
+    bytes: &[u8],
+) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::Image(format!("{}: cannot write an empty {width}×{height} PNG", what.display())));
+    }
+    let mut enc = png::Encoder::new(w, width, height);
+    enc.set_color(color);
+    enc.set_depth(depth);
+    let mut writer = enc.write_header().map_err(|e| image_err(what, e))?;
+    writer.write_image_data(bytes).map_err(|e| image_err(what, e))?;
+    writer.finish().map_err(|e| image_err(what, e))
+}
+
 fn write_png(
     path: &Path,
     width: u32,
@@ -32,49 +53,71 @@ fn write_png(
         return Err(Error::Image(format!("{}: cannot write an empty {width}×{height} PNG", path.display())));
     }
     let file = File::create(path)?;
-    let mut enc = png::Encoder::new(BufWriter::new(file), width, height);
-    enc.set_color(color);
-    enc.set_depth(depth);
-    let mut writer = enc.write_header().map_err(|e| image_err(path, e))?;
-    writer.write_image_data(bytes).map_err(|e| image_err(path, e))?;
-    writer.finish().map_err(|e| image_err(path, e))
+    encode_into(BufWriter::new(file), path, width, height, color, depth, bytes)
+}
+
+/// The PNG file bytes (the same bytes the `write_png_*` functions write).
+fn encode_png(width: u32, height: u32, color: png::ColorType, depth: png::BitDepth, bytes: &[u8]) -> Result<Vec<u8>> {
+    let mut out = Vec::new();
+    encode_into(&mut out, Path::new("<in-memory PNG>"), width, height, color, depth, bytes)?;
+    Ok(out)
+}
+
+fn gray8_samples(img: &ImageF32) -> Vec<u8> {
+    img.data.iter().map(|&v| quantize(v, 255.0) as u8).collect()
+}
+
+fn gray16_samples(img: &ImageF32, scale: f64) -> Vec<u8> {
+    let mut bytes = Vec::with_capacity(img.data.len() * 2);
+    for &v in &img.data {
+        let q = if v.is_nan() { 0 } else { (v as f64 * scale).round().clamp(0.0, 65535.0) as u16 };
+        bytes.extend_from_slice(&q.to_be_bytes());
+    }
+    bytes
+}
+
+/// [`write_png_gray8`] into memory: the PNG file's bytes (for a `Recorder::file`).
+pub fn encode_png_gray8(img: &ImageF32) -> Result<Vec<u8>> {
+    encode_png(img.width, img.height, png::ColorType::Grayscale, png::BitDepth::Eight, &gray8_samples(img))
+}
+
+/// [`write_png_gray16`] into memory: the PNG file's bytes.
+pub fn encode_png_gray16(img: &ImageF32, scale: f64) -> Result<Vec<u8>> {
+    let s = gray16_samples(img, scale);
+    encode_png(img.width, img.height, png::ColorType::Grayscale, png::BitDepth::Sixteen, &s)
+}
+
+/// [`write_png_rgb8`] into memory: the PNG file's bytes.
+pub fn encode_png_rgb8(img: &ImageRgbF32) -> Result<Vec<u8>> {
+    let bytes: Vec<u8> = img.data.iter().flat_map(|c| c.map(|v| quantize(v, 255.0) as u8)).collect();
+    encode_png(img.width, img.height, png::ColorType::Rgb, png::BitDepth::Eight, &bytes)
+}
+
+/// [`write_png_mask`] into memory: the PNG file's bytes.
+pub fn encode_png_mask(m: &Mask) -> Result<Vec<u8>> {
+    let bytes: Vec<u8> = m.data.iter().map(|&b| if b { 255 } else { 0 }).collect();
+    encode_png(m.width, m.height, png::ColorType::Grayscale, png::BitDepth::Eight, &bytes)
 }
 
 /// Writes an 8-bit grayscale PNG: each value `v ∈ [0, 1]` becomes `round(255 v)` (clamped,
 /// NaN → 0).
 pub fn write_png_gray8(path: impl AsRef<Path>, img: &ImageF32) -> Result<()> {
-    let bytes: Vec<u8> = img.data.iter().map(|&v| quantize(v, 255.0) as u8).collect();
+    let bytes = gray8_samples(img);
     write_png(path.as_ref(), img.width, img.height, png::ColorType::Grayscale, png::BitDepth::Eight, &bytes)
 }
 
 /// Encodes an image as an 8-bit grayscale PNG in memory (the bytes [`write_png_gray8`] writes),
-/// for outputs handed to a [`crate::record::Recorder`] as files.
+/// for outputs handed to a [`crate::record::Recorder`] as files: [`encode_png_gray8`] (the name
+/// flip-tet's experiments use).
 pub fn png_gray8_bytes(img: &ImageF32) -> Result<Vec<u8>> {
-    if img.width == 0 || img.height == 0 {
-        return Err(Error::Image(format!("cannot encode an empty {}×{} PNG", img.width, img.height)));
-    }
-    let bytes: Vec<u8> = img.data.iter().map(|&v| quantize(v, 255.0) as u8).collect();
-    let mut out = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut out, img.width, img.height);
-        enc.set_color(png::ColorType::Grayscale);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut writer = enc.write_header().map_err(|e| Error::Image(e.to_string()))?;
-        writer.write_image_data(&bytes).map_err(|e| Error::Image(e.to_string()))?;
-        writer.finish().map_err(|e| Error::Image(e.to_string()))?;
-    }
-    Ok(out)
+    encode_png_gray8(img)
 }
 
 /// Writes a 16-bit grayscale PNG: each value `v` becomes `round(v · scale)` clamped to
 /// `0..=65535` (NaN → 0). Use `scale = 65535` for `[0, 1]` data (then [`read_png`] returns `v` to
 /// within `1/131070`), or e.g. `scale = 1000` to store depths in millimetres.
 pub fn write_png_gray16(path: impl AsRef<Path>, img: &ImageF32, scale: f64) -> Result<()> {
-    let mut bytes = Vec::with_capacity(img.data.len() * 2);
-    for &v in &img.data {
-        let q = if v.is_nan() { 0 } else { (v as f64 * scale).round().clamp(0.0, 65535.0) as u16 };
-        bytes.extend_from_slice(&q.to_be_bytes());
-    }
+    let bytes = gray16_samples(img, scale);
     write_png(path.as_ref(), img.width, img.height, png::ColorType::Grayscale, png::BitDepth::Sixteen, &bytes)
 }
 

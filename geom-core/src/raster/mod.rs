@@ -24,4 +24,4 @@ mod views;
 pub use camera::Camera;
 pub use gbuffer::{GBuffer, NormalSpace};
 pub use rasterize::{rasterize, rasterize_uv, RasterOptions};
-pub use views::{lambert_preview, render_views, RenderedViews, AMBIENT};
+pub use views::{lambert_preview, render_images, render_views, RenderedViews, ViewImages, AMBIENT};

@@ -67,10 +67,54 @@ pub struct RenderedViews {
     pub depth_max: f64,
 }
 
-/// Renders the mesh `(p, faces)` with camera `c` and writes four PNGs into `dir` (created if
-/// missing): `{stem}_depth.png`, `{stem}_normal.png`, `{stem}_silhouette.png` and
-/// `{stem}_shaded.png`. One rasterisation serves all four images. Errors: file system and PNG
-/// encoding failures (naming the file).
+/// The four standard views of a mesh, in memory ([`render_images`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewImages {
+    /// Nearest depth `w` per pixel (0 = background).
+    pub depth: ImageF32,
+    /// Camera-space smooth normals, `(n + 1)/2` per channel, background black.
+    pub normal: ImageRgbF32,
+    /// Pixels whose coverage exceeds one half.
+    pub silhouette: Mask,
+    /// Lambert preview ([`lambert_preview`]).
+    pub shaded: ImageF32,
+    /// Largest depth in the image, 0 if nothing is visible, NaN if a depth is NaN.
+    pub depth_max: f64,
+}
+
+impl ViewImages {
+    /// The scale that maps depth to the 16-bit PNG's full range (`65535 / depth_max`; 0 when
+    /// nothing is visible).
+    pub fn depth_scale(&self) -> f64 {
+        if self.depth_max > 0.0 {
+            65535.0 / self.depth_max
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Renders the mesh `(p, faces)` with camera `c` into the four standard views (one
+/// rasterisation serves all four).
+pub fn render_images(c: &Camera, p: &[Pt3], faces: &[[u32; 3]], light: &Vec3, o: &RasterOptions) -> ViewImages {
+    let gb = rasterize(c, p, faces, o);
+    let depth: ImageF32 = gb.depth();
+    // NaN-propagating maximum: a NaN depth (NaN positions) must not read as a valid image.
+    let depth_max =
+        depth.data.iter().copied().fold(0.0f32, |m, v| if m.is_nan() || v.is_nan() { f32::NAN } else { m.max(v) })
+            as f64;
+    ViewImages {
+        normal: gb.normals(c, p, faces, NormalSpace::Camera, true),
+        silhouette: gb.silhouette(0.5),
+        shaded: lambert_resolve(&gb, c, p, faces, light),
+        depth,
+        depth_max,
+    }
+}
+
+/// Renders the mesh `(p, faces)` with camera `c` ([`render_images`]) and writes four PNGs into
+/// `dir` (created if missing): `{stem}_depth.png`, `{stem}_normal.png`, `{stem}_silhouette.png`
+/// and `{stem}_shaded.png`. Errors: file system and PNG encoding failures (naming the file).
 pub fn render_views(
     c: &Camera,
     p: &[Pt3],
@@ -81,23 +125,17 @@ pub fn render_views(
     stem: &str,
 ) -> Result<RenderedViews> {
     std::fs::create_dir_all(dir)?;
-    let gb = rasterize(c, p, faces, o);
-    let depth: ImageF32 = gb.depth();
-    let depth_max = depth.data.iter().copied().fold(0.0f32, f32::max) as f64;
-    let normal: ImageRgbF32 = gb.normals(c, p, faces, NormalSpace::Camera, true);
-    let silhouette: Mask = gb.silhouette(0.5);
-    let shaded = lambert_resolve(&gb, c, p, faces, light);
+    let v = render_images(c, p, faces, light, o);
     let out = RenderedViews {
         depth: dir.join(format!("{stem}_depth.png")),
         normal: dir.join(format!("{stem}_normal.png")),
         silhouette: dir.join(format!("{stem}_silhouette.png")),
         shaded: dir.join(format!("{stem}_shaded.png")),
-        depth_max,
+        depth_max: v.depth_max,
     };
-    let scale = if depth_max > 0.0 { 65535.0 / depth_max } else { 0.0 };
-    write_png_gray16(&out.depth, &depth, scale)?;
-    write_png_rgb8(&out.normal, &normal)?;
-    write_png_mask(&out.silhouette, &silhouette)?;
-    write_png_gray8(&out.shaded, &shaded)?;
+    write_png_gray16(&out.depth, &v.depth, v.depth_scale())?;
+    write_png_rgb8(&out.normal, &v.normal)?;
+    write_png_mask(&out.silhouette, &v.silhouette)?;
+    write_png_gray8(&out.shaded, &v.shaded)?;
     Ok(out)
 }

@@ -195,7 +195,7 @@ fn default_true() -> bool {
 }
 
 impl Params {
-    /// Resolves relative BVH paths against `root` (the workspace root for the built-in scenes).
+    /// Resolves relative BVH paths against `root` (the scene file's folder).
     pub fn resolve_paths(&mut self, root: &Path) {
         for s in &mut self.database.sources {
             if let Source::Bvh { path, .. } = s {

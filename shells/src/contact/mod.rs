@@ -54,6 +54,9 @@ pub struct ContactStats {
     pub line_search_failures: u32,
     /// Newton iterations that ended without reaching the tolerance.
     pub unconverged: u32,
+    /// 1 when the step ended on the contact-free path (no pair within d̂, no friction, the full
+    /// linearised step taken: the seed's integrator), else 0.
+    pub contact_free_steps: u32,
 }
 
 /// The IPC contact model of one simulation.

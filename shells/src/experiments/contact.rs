@@ -22,7 +22,7 @@ use super::protocol::{self, RunPlan};
 use crate::effects::ObstacleShape;
 use crate::error::{Error, Result};
 use crate::metrics::Sanity;
-use crate::scene::{MeshSpec, ShellScene};
+use crate::scene::ShellScene;
 use crate::sim::ShellSim;
 
 /// Parameters of a contact-suite scene (the RON `params` block).
@@ -58,19 +58,7 @@ fn strain_target() -> f64 {
 
 /// The shell scene at a run size.
 pub fn sized(p: &Params, size: Size) -> ShellScene {
-    let mut s = p.shell.clone();
-    if let Some(r) = &p.resolution {
-        let (a, b) = r.get(size);
-        match &mut s.mesh {
-            MeshSpec::Grid { nx, ny, .. } => (*nx, *ny) = (a, b),
-            MeshSpec::Tube { around, along, .. } => (*around, *along) = (a, b),
-            MeshSpec::Obj { .. } => {}
-        }
-    }
-    if let Some(d) = &p.duration {
-        s.duration = d.get(size);
-    }
-    s
+    protocol::sized(&p.shell, p.resolution.as_ref(), p.duration.as_ref(), size)
 }
 
 /// Context of the scene for previews: ground planes, obstacle meshes, pinned vertices, frame
@@ -178,6 +166,7 @@ pub fn sanity_figures(r: &mut Report, suffix: &str, s: &Sanity, rs: &protocol::R
     r.num(&k("min_contact_gap_m"), if c.min_gap.is_finite() { c.min_gap } else { f64::NAN });
     r.count(&k("ccd_clamped_steps"), c.ccd_clamps as u64);
     r.count(&k("unconverged_steps"), c.unconverged as u64);
+    r.count(&k("contact_free_steps"), c.contact_free_steps as u64);
     r.count(&k("line_search_failures"), c.line_search_failures as u64);
 }
 

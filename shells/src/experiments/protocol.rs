@@ -1,15 +1,42 @@
 //! The run protocol every `shells` experiment (and `tracks`' untracked twin) shares: step a
 //! simulation frame by frame, record each frame the moment it exists, watch the physical-sanity
 //! invariants after every step ([`Sanity`]), time every step, and sum the per-step statistics.
+//! [`sized`] gives a scene's mesh resolution and duration at a run size.
 
 use std::time::Instant;
 
+use geom_core::experiment::{BySize, Size};
 use geom_core::record::{Attribute, Cell, MeshFrame, Recorder};
 
 use crate::error::Result;
 use crate::integrator::StepStats;
 use crate::metrics::Sanity;
+use crate::scene::{MeshSpec, ShellScene};
 use crate::sim::ShellSim;
+
+/// The shell scene at a run size: `resolution` sets a grid's (nx, ny) vertices or a tube's
+/// (around, along) (an OBJ mesh is kept), `duration` the simulated time (s); `None` keeps the
+/// scene's value.
+pub fn sized(
+    shell: &ShellScene,
+    resolution: Option<&BySize<(u32, u32)>>,
+    duration: Option<&BySize<f64>>,
+    size: Size,
+) -> ShellScene {
+    let mut s = shell.clone();
+    if let Some(r) = resolution {
+        let (a, b) = r.get(size);
+        match &mut s.mesh {
+            MeshSpec::Grid { nx, ny, .. } => (*nx, *ny) = (a, b),
+            MeshSpec::Tube { around, along, .. } => (*around, *along) = (a, b),
+            MeshSpec::Obj { .. } => {}
+        }
+    }
+    if let Some(d) = duration {
+        s.duration = d.get(size);
+    }
+    s
+}
 
 /// How to run.
 #[derive(Clone, Debug)]
@@ -28,7 +55,8 @@ pub struct RunPlan {
     pub count_intersections: bool,
     /// Track the energy for `energy_gain_rel`.
     pub track_energy: bool,
-    /// Write the per-step table `steps_<sequence>` (and `frames_<sequence>`).
+    /// Write the per-step table `steps_<sequence>` and the per-frame table `frames_<sequence>`
+    /// (t, energies, exact self-intersections of the frame when they are counted, else −1).
     pub tables: bool,
 }
 
@@ -80,12 +108,51 @@ impl RunStats {
         c.ccd_clamps += st.contact.ccd_clamps;
         c.line_search_failures += st.contact.line_search_failures;
         c.unconverged += st.contact.unconverged;
+        c.contact_free_steps += st.contact.contact_free_steps;
         c.friction = c.friction.max(st.contact.friction);
         c.active = c.active.max(st.contact.active);
         c.min_gap = if self.steps == 1 { st.contact.min_gap } else { c.min_gap.min(st.contact.min_gap) };
         c.kappa = st.contact.kappa;
         self.max_zone = self.max_zone.max(st.max_zone_size);
         self.max_active_contacts = self.max_active_contacts.max(st.contact.active);
+    }
+
+    /// Adds the statistics of another run (of a scene made of several runs): step counts,
+    /// times and counters summed, maxima kept, `contact.min_gap` the minimum, the first error
+    /// kept.
+    pub fn merge(&mut self, o: &RunStats) {
+        self.steps += o.steps;
+        self.step_wall.extend_from_slice(&o.step_wall);
+        self.newton_iters.extend_from_slice(&o.newton_iters);
+        self.max_intersections = self.max_intersections.max(o.max_intersections);
+        self.nan_steps += o.nan_steps;
+        if self.error.is_none() {
+            self.error.clone_from(&o.error);
+        }
+        self.max_zone = self.max_zone.max(o.max_zone);
+        self.max_active_contacts = self.max_active_contacts.max(o.max_active_contacts);
+        let (t, u) = (&mut self.totals, &o.totals);
+        t.t_assembly += u.t_assembly;
+        t.t_factor += u.t_factor;
+        t.t_solve += u.t_solve;
+        t.t_collision += u.t_collision;
+        t.n_proximity += u.n_proximity;
+        t.n_ccd += u.n_ccd;
+        t.n_impact_zones += u.n_impact_zones;
+        t.n_frozen += u.n_frozen;
+        t.plastic_events += u.plastic_events;
+        t.newton_iters += u.newton_iters;
+        t.line_search_halvings += u.line_search_halvings;
+        t.lin_residual = geom_core::stats::nan_max(t.lin_residual, u.lin_residual);
+        t.regularization_shift = t.regularization_shift.max(u.regularization_shift);
+        let (c, d) = (&mut t.contact, &u.contact);
+        c.ccd_clamps += d.ccd_clamps;
+        c.line_search_failures += d.line_search_failures;
+        c.unconverged += d.unconverged;
+        c.friction = c.friction.max(d.friction);
+        c.active = c.active.max(d.active);
+        c.min_gap = c.min_gap.min(d.min_gap);
+        c.kappa = d.kappa;
     }
 
     /// Mean wall time per step (s).
@@ -110,7 +177,12 @@ pub fn run(
     rs.totals.contact.min_gap = f64::INFINITY;
     let seq = plan.sequence.as_str();
     let steps_table = format!("steps_{seq}");
+    let frames_table = format!("frames_{seq}");
     if plan.tables {
+        rec.table(
+            &frames_table,
+            &["frame", "t", "kinetic_J", "membrane_J", "bending_J", "gravity_J", "intersections"],
+        )?;
         rec.table(
             &steps_table,
             &[
@@ -127,6 +199,7 @@ pub fn run(
         )?;
     }
     let record = |sim: &ShellSim, f: usize, rec: &mut dyn Recorder, rs: &mut RunStats| -> Result<()> {
+        let mut inter = -1i64;
         if plan.frame_every > 0 && f.is_multiple_of(plan.frame_every) {
             let strain = edge_strain_per_vertex(sim);
             let attrs = [Attribute { name: "strain", values: &strain }];
@@ -141,7 +214,23 @@ pub fn run(
             if plan.count_intersections {
                 let k = crate::collision::count_self_intersections(&sim.state().q, &faces) as u64;
                 rs.max_intersections = rs.max_intersections.max(k);
+                inter = k as i64;
             }
+        }
+        if plan.tables {
+            let e = sim.energies();
+            rec.row(
+                &frames_table,
+                &[
+                    Cell::Int(f as i64),
+                    Cell::from(sim.state().t),
+                    Cell::from(e.kinetic),
+                    Cell::from(e.membrane),
+                    Cell::from(e.bending),
+                    Cell::from(e.gravity),
+                    Cell::Int(inter),
+                ],
+            )?;
         }
         Ok(())
     };

@@ -7,7 +7,7 @@
 use motion_graph::experiments::search::{run, Params};
 
 use crate::error::{Error, Result};
-use crate::out::{workspace_root, Summary};
+use crate::out::Summary;
 use crate::record::run_experiment;
 use crate::registry::{RunCtx, Runner};
 
@@ -26,7 +26,7 @@ pub fn register(v: &mut Vec<Runner>) {
 fn run_search(ctx: &RunCtx) -> Result<Summary> {
     run_experiment(ctx, |p: &Params, size, rec| {
         let mut p = p.clone();
-        p.resolve_paths(&workspace_root());
+        p.resolve_paths(&ctx.resolve("."));
         run(&p, size, rec)
     })
 }
