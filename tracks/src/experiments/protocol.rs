@@ -204,6 +204,9 @@ pub struct PairOut {
     pub sanity_tracked: Option<Sanity>,
     /// Physical-sanity figures of the untracked cloth over every step (`None` without the twin).
     pub sanity_untracked: Option<Sanity>,
+    /// Edge strain of the guide itself over the frames, against the guide's rest mesh: what the
+    /// constraints ask of the cloth (a guide that stretches makes the tracked cloth stretch).
+    pub sanity_guide: Option<Sanity>,
     /// Exact self-intersection count, max over the counted frames (every frame with
     /// `intersections`, otherwise every recorded frame and the last one), tracked / untracked.
     pub max_intersections: (u64, u64),
@@ -289,6 +292,10 @@ impl PairOut {
             r.num(&format!("max_obstacle_penetration_m_{name}"), s.max_obstacle_penetration_m);
             r.count(&format!("max_intersections_{name}"), isect);
         }
+        if let Some(g) = &self.sanity_guide {
+            r.num("max_edge_strain_guide", g.max_edge_strain);
+            r.num("max_edge_compression_guide", g.max_edge_compression);
+        }
     }
 
     /// The D_c(t) curves of the tracked and the untracked run (plot `deviation`).
@@ -330,6 +337,17 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
     let sanity = |s: &ShellSim| Sanity::new(&s.mesh().rest, &s.mesh().edges, obstacles.clone(), None);
     let mut san_t = sanity(&tr.sim);
     let mut san_u = un.as_ref().map(sanity);
+    let mut san_g = {
+        let gm = &setup.guide.rest;
+        let mut e: Vec<[u32; 2]> = gm
+            .faces
+            .iter()
+            .flat_map(|f| (0..3).map(move |k| [f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3])]))
+            .collect();
+        e.sort_unstable();
+        e.dedup();
+        Sanity::new(&gm.positions, &e, Vec::new(), None)
+    };
     let k_lp = out.k.max(1);
     let lp = LowPass::new(&setup.tracked_rest, LowPass::tau_for(&setup.tracked_rest, k_lp))?;
     let h = setup.h();
@@ -423,6 +441,7 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
         // Metrics (not timed).
         let t = tr.sim.state().t;
         setup.guide.sample(t, &mut gq);
+        san_g.observe(&gq, t, None);
         let gf = guide_on_tracked(setup.prolongation.as_ref(), &gq);
         let q = &tr.sim.state().q;
         let d: Vec<Vec3> = q.iter().zip(&gf).map(|(a, b)| a - b).collect();
@@ -498,6 +517,7 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
     }
     out.sanity_tracked = Some(san_t);
     out.sanity_untracked = san_u;
+    out.sanity_guide = Some(san_g);
     out.final_tracked = tr.sim.state().q.clone();
     if let Some(u) = un.as_ref() {
         out.final_untracked = u.state().q.clone();
