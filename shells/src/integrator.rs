@@ -153,4 +153,15 @@ pub struct ImplicitSystem<'a> {
 pub trait VelocitySolve {
     /// Returns Δv for the free DOFs (length 3 n_free).
     fn solve(&mut self, sys: &ImplicitSystem) -> Result<Vec<f64>>;
+
+    /// The term this solver adds to the IPC line search's merit function at end-of-step
+    /// positions `q` (all vertices), in the units of the incremental potential Φ (J). A solver
+    /// that imposes equality constraints C v = r returns an exact penalty ρ·Σᵢ‖cᵢ(q)‖ with ρ
+    /// above its multipliers' norm, so that its constrained Newton direction is a descent
+    /// direction of Φ + merit (Nocedal & Wright, *Numerical Optimization*, §18.3, eq. 18.36):
+    /// without it a constraint that pulls uphill in Φ makes every line search fail. The
+    /// default, for unconstrained solves, is 0.
+    fn merit(&mut self, _q: &[Pt3]) -> f64 {
+        0.0
+    }
 }

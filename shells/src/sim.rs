@@ -838,6 +838,35 @@ impl ShellSim {
                 Some(p) => p,
                 None => self.ipc_potential(ipc, q_base, h_eff, v_ref, v_cur, t_next, alpha),
             };
+            // The line search's merit: Φ, plus the wind's work linearised at this iterate (drag
+            // depends on v and has no potential; −h_eff (v − v_k)·F_w(x_k, v_k) makes the slope
+            // along Δv the −bᵀΔv the system was solved with — without it every line search of a
+            // cloth moving through air fails), plus the delegated solver's constraint penalty
+            // ([`VelocitySolve::merit`]).
+            let wind_slope = match self.wind.as_ref() {
+                Some(w) => {
+                    let fw = w.vertex_forces(&self.mesh.tris, &x, v_cur, t_next);
+                    h_eff
+                        * free
+                            .iter()
+                            .enumerate()
+                            .map(|(fidx, &vtx)| {
+                                fw[vtx as usize].dot(&Vec3::new(dv[3 * fidx], dv[3 * fidx + 1], dv[3 * fidx + 2]))
+                            })
+                            .sum::<f64>()
+                }
+                None => 0.0,
+            };
+            let mut merit = |vv: &[Vec3]| -> f64 {
+                match solver.as_deref_mut() {
+                    Some(s) => {
+                        let q: Vec<Pt3> = q_base.iter().zip(vv).map(|(p, v)| p + h_eff * v).collect();
+                        s.merit(&q)
+                    }
+                    None => 0.0,
+                }
+            };
+            let m0 = phi0 + merit(v_cur);
             let mut trial = v_cur.to_vec();
             let mut accepted = false;
             let mut phi = phi0;
@@ -848,7 +877,7 @@ impl ShellSim {
                     trial[i] = v_cur[i] + a * Vec3::new(dv[3 * fidx], dv[3 * fidx + 1], dv[3 * fidx + 2]);
                 }
                 phi = self.ipc_potential(ipc, q_base, h_eff, v_ref, &trial, t_next, alpha);
-                if phi <= phi0 {
+                if phi - a * wind_slope + merit(&trial) <= m0 {
                     accepted = true;
                     break;
                 }

@@ -82,6 +82,25 @@ impl WindField {
     }
 }
 
+impl WindField {
+    /// The wind force on every vertex (N) of the triangles `tris` at positions `q` and vertex
+    /// velocities `v` at time t: each triangle's [`WindField::triangle`] force on its three
+    /// vertices, summed in triangle order (deterministic). The same forces the assembly adds to
+    /// the implicit system's right-hand side.
+    pub fn vertex_forces(&self, tris: &[[u32; 3]], q: &[Pt3], v: &[Vec3], t: f64) -> Vec<Vec3> {
+        let mut f = vec![Vec3::zeros(); q.len()];
+        for tri in tris {
+            let x = tri.map(|i| q[i as usize]);
+            let vl = tri.map(|i| v[i as usize]);
+            let (fw, _) = self.triangle(&x, &vl, t);
+            for &i in tri {
+                f[i as usize] += fw;
+            }
+        }
+        f
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -177,6 +177,11 @@ pub struct TrackingSolver {
     /// Solvers of `TrackOptions::compare`, run on every system after the main solve.
     shadows: Vec<TrackingSolver>,
     gbuf: Vec<Pt3>,
+    /// Exact-penalty weight ρ of the IPC line search's merit (J·s/m, the multipliers' unit):
+    /// twice the largest ‖μᵢ‖ of this step's solves; reset by [`TrackingSolver::begin_step`].
+    merit_rho: f64,
+    /// h_eff of the last solve (s): the merit's constraint values are g(q)/h_eff.
+    merit_h: f64,
     /// Statistics of the last solve.
     pub last: KktStats,
 }
@@ -227,6 +232,8 @@ impl TrackingSolver {
             mu_prev: Vec::new(),
             guide_scale,
             gbuf: vec![Pt3::origin(); nb],
+            merit_rho: 0.0,
+            merit_h: 1.0,
             last: KktStats::default(),
         }
     }
@@ -237,6 +244,7 @@ impl TrackingSolver {
         self.last.t_kkt = 0.0;
         self.last.t_shadow_llt = 0.0;
         self.last.solves = 0;
+        self.merit_rho = 0.0;
     }
 
     /// The constraints this solver enforces.
@@ -695,6 +703,17 @@ fn interleaved_order(a_perm: &[usize], cft: &[Vec<(u32, f64)>], m: usize) -> Vec
 }
 
 impl VelocitySolve for TrackingSolver {
+    /// ρ·Σᵢ‖gᵢ(q, t_next)‖/h_eff, the ℓ1 exact penalty of the constraints at positions `q`
+    /// with ρ = 2·max‖μᵢ‖ of this step's solves (see [`VelocitySolve::merit`]).
+    fn merit(&mut self, q: &[Pt3]) -> f64 {
+        if self.merit_rho == 0.0 {
+            return 0.0;
+        }
+        let mut g = vec![Vec3::zeros(); self.cons.len()];
+        self.cons.residual(&self.gbuf, q, &mut g);
+        self.merit_rho * g.iter().map(|x| x.norm()).sum::<f64>() / self.merit_h
+    }
+
     fn solve(&mut self, sys: &ImplicitSystem) -> shells::Result<Vec<f64>> {
         let t0 = Instant::now();
         self.build_cft(sys);
@@ -706,6 +725,10 @@ impl VelocitySolve for TrackingSolver {
         let r: Vec<f64> = g.iter().flat_map(|gi| [c * gi.x, c * gi.y, c * gi.z]).collect();
         let (dv, mu) = self.solve_method(sys, &r)?;
         self.last.solves += 1;
+        // Exact-penalty weight above the multipliers (constraint rows cᵢ = gᵢ/h_eff, m/s).
+        let mu_max = mu.chunks(3).map(|c| (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt()).fold(0.0, f64::max);
+        self.merit_rho = self.merit_rho.max(2.0 * mu_max);
+        self.merit_h = sys.h_eff;
         // Summed over the step's Newton iterations (IPC solves one KKT system per iteration;
         // `begin_step` resets).
         self.last.t_kkt += t0.elapsed().as_secs_f64();

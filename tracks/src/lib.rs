@@ -11,7 +11,9 @@
 //! [`constraints`] (𝓜, C̄, C, eq. 8, rank), [`kkt`] (the saddle-point solvers) and [`augmented`] (the augmented-Lagrangian one), [`tracker`] (the
 //! constrained step, initial projection, residuals), [`metrics`] (deviation, wavelength, tug
 //! index, …), [`procedural`] (the guides of the paper's scenes), [`rest_events`] (scheduled rest-angle
-//! changes) and [`capture`] (one step's system kept for benchmarks).
+//! changes) and [`capture`] (one step's system kept for benchmarks); [`presets`] (the paper's
+//! materials and scene setups) and [`experiments`] (every figure and table of the paper as a
+//! callable experiment, the lockstep tracked/untracked run protocol).
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 #![allow(clippy::needless_range_loop)]
@@ -21,9 +23,11 @@ pub mod capture;
 pub mod cluster;
 pub mod constraints;
 pub mod error;
+pub mod experiments;
 pub mod guide;
 pub mod kkt;
 pub mod metrics;
+pub mod presets;
 pub mod procedural;
 pub mod rest_events;
 pub mod testfn;

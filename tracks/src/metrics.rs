@@ -213,6 +213,108 @@ pub fn seam_joint_alignment(mesh: &TriMesh, vertex_labels: &[u32], max_weight: &
     s / all
 }
 
+// ---------------------------------------------------------------------------------------------
+// figures of the scenes (computed from per-step and per-frame series)
+
+/// Overhead of tracking (%) = 100·(Σ tracked step time / Σ untracked step time − 1) (Bergou et
+/// al. 2007 §5.5 "overhead"); NaN without an untracked run.
+pub fn overhead_pct(t_tracked: f64, t_untracked: f64) -> f64 {
+    if t_untracked > 0.0 {
+        100.0 * (t_tracked / t_untracked - 1.0)
+    } else {
+        f64::NAN
+    }
+}
+
+/// Overhead (%) from the median tracked and untracked step times (robust to load bursts of a
+/// shared machine); `step_times` = (tracked, untracked) wall time per step (s).
+pub fn overhead_pct_median(step_times: &[(f64, f64)]) -> f64 {
+    let t: Vec<f64> = step_times.iter().map(|x| x.0).collect();
+    let u: Vec<f64> = step_times.iter().map(|x| x.1).collect();
+    100.0 * (geom_core::stats::median(&t) / geom_core::stats::median(&u) - 1.0)
+}
+
+/// The tracked step's linear-solve cost relative to the untracked one (issue 20): the median
+/// over steps of the tracked step's constrained solve time `t_kkt` (assembly of the KKT values,
+/// numeric factorisation and solve, summed over the step's Newton iterations) over the median of
+/// the untracked step's numeric factorisation + solve of A (`t_factor + t_solve`, also summed
+/// over its iterations). Dimensionless; NaN when either sample is empty.
+pub fn kkt_over_untracked_factor(t_kkt: &[f64], t_factor_solve_untracked: &[f64]) -> f64 {
+    geom_core::stats::median(t_kkt) / geom_core::stats::median(t_factor_solve_untracked)
+}
+
+/// Largest value of `v` over the frames with time t ∈ [a, b] (`times` aligned with `v`); NaN
+/// when no frame falls in the window or a value there is NaN.
+pub fn window_max(times: &[f64], v: &[f64], a: f64, b: f64) -> f64 {
+    let sel: Vec<f64> = times.iter().zip(v).filter(|(t, _)| **t >= a && **t <= b).map(|(_, e)| *e).collect();
+    geom_core::stats::max(&sel)
+}
+
+/// Mean of `v` over the frames with a − 1e-9 ≤ t ≤ b + 1e-9; NaN when none.
+pub fn window_mean(times: &[f64], v: &[f64], a: f64, b: f64) -> f64 {
+    let sel: Vec<f64> =
+        times.iter().zip(v).filter(|(x, _)| **x >= a - 1e-9 && **x <= b + 1e-9).map(|(_, y)| *y).collect();
+    geom_core::stats::mean(&sel)
+}
+
+/// Value of `v` at the first frame within `tol` s of `t`, NaN when none.
+pub fn value_at(times: &[f64], v: &[f64], t: f64, tol: f64) -> f64 {
+    times.iter().zip(v).find(|(x, _)| (**x - t).abs() < tol).map_or(f64::NAN, |(_, y)| *y)
+}
+
+/// Centroid (unweighted mean of the vertices) (m).
+pub fn centroid(q: &[Pt3]) -> Pt3 {
+    Pt3::from(q.iter().fold(Vec3::zeros(), |a, p| a + p.coords) / q.len() as f64)
+}
+
+/// Mean vertex speed (m/s).
+pub fn mean_speed(v: &[Vec3]) -> f64 {
+    v.iter().map(|x| x.norm()).sum::<f64>() / v.len() as f64
+}
+
+/// Distance (m) of a point from the flag's branch axis (the line x = 2.0, y = 1.2 m along z).
+pub fn branch_distance(c: &Pt3) -> f64 {
+    ((c.x - 2.0).powi(2) + (c.y - 1.2).powi(2)).sqrt()
+}
+
+/// Stuck on the branch (§5.1): the last centroid within 0.3 m of the branch axis and mean speed
+/// < 0.05 m/s over the last 0.5 s (`centroids`, `speeds` per frame at `fps`).
+pub fn stuck_on_branch(centroids: &[Pt3], speeds: &[f64], fps: f64) -> bool {
+    let n = (0.5 * fps).round() as usize;
+    let (Some(c), true) = (centroids.last(), speeds.len() >= n) else { return false };
+    let mean_v = speeds[speeds.len() - n..].iter().sum::<f64>() / n as f64;
+    branch_distance(c) < 0.3 && mean_v < 0.05
+}
+
+/// Largest displacement (m) of any guide vertex between `t0` and the frames (at `fps`) up to
+/// `t1` (the guide's kinetic energy after `t0` is zero iff this is zero).
+pub fn guide_motion_after(guide: &GuideAnimation, t0: f64, t1: f64, fps: f64) -> f64 {
+    let mut a = vec![Pt3::origin(); guide.n_vertices()];
+    let mut b = a.clone();
+    guide.sample(t0, &mut a);
+    let mut worst = 0.0f64;
+    let mut t = t0;
+    while t <= t1 + 1e-9 {
+        guide.sample(t, &mut b);
+        worst = a.iter().zip(&b).map(|(x, y)| (x - y).norm()).fold(worst, geom_core::stats::nan_max);
+        t += 1.0 / fps;
+    }
+    worst
+}
+
+/// Coefficient of variation (std / mean) of the region areas of a triangle labelling (Fig. 7's
+/// evenness of the regions).
+pub fn region_area_cv(mesh: &TriMesh, tri_labels: &[u32], regions: usize) -> f64 {
+    let areas = geom_core::mesh::face_areas(&mesh.faces, &mesh.positions);
+    let mut ra = vec![0.0; regions];
+    for (f, &l) in tri_labels.iter().enumerate() {
+        ra[l as usize] += areas[f];
+    }
+    let n = ra.len() as f64;
+    let mean = geom_core::stats::mean(&ra);
+    (ra.iter().map(|a| (a - mean).powi(2)).sum::<f64>() / n).sqrt() / mean
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -206,6 +206,24 @@ pub struct Xavier {
     pub quality: (f64, f64),
 }
 
+impl Xavier {
+    /// Per vertex, the largest linear-blend-skinning weight of the rig of [`xavier_guide`] (root,
+    /// and an upper and a lower bone per limb): < 0.8 near a joint (Fig. 7's seam–joint
+    /// alignment).
+    pub fn max_skin_weight(&self) -> Vec<f64> {
+        self.membership
+            .iter()
+            .zip(&self.s)
+            .map(|(mb, &s)| {
+                let root = 1.0 - smoothstep(0.25, 0.4, s);
+                let up = smoothstep(0.25, 0.4, s) * (1.0 - smoothstep(0.55, 0.7, s));
+                let lo = smoothstep(0.55, 0.7, s);
+                mb.iter().flat_map(|w| [w * up, w * lo]).fold(root, f64::max)
+            })
+            .collect()
+    }
+}
+
 /// Xavier's cloth (`tracks/xavier`, spec §6.4): 0.2 kg/m², Et = 3000 N/m, ν = 0.3, k_B = 2e-5 J,
 /// stiffness-proportional damping β = 5e-4 s.
 pub fn xavier_material() -> shells::Material {

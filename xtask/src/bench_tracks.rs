@@ -1,25 +1,36 @@
-//! `cargo xtask bench tracks` (issue 4, spec §9): what accuracy costs in time.
-//! 1. The Xavier clip (walk, from t = 0) with uniform animation-aware clusterings of 16, 64, 256
-//!    and 1024 regions: deviation from the guide (area-weighted RMS ‖q − q̄‖ / L, mean over
-//!    frames) and wavelength λ_eff of the deviation field against the time per frame, tracked and
-//!    untracked in lockstep (`partitions.csv` and the four PNGs of the partition study).
+//! `cargo xtask bench tracks` (spec §9): what accuracy costs in time, over library calls of
+//! `tracks::experiments`.
+//! 1. The Xavier clip with uniform animation-aware clusterings of 16, 64, 256 (and 1024) regions
+//!    ([`partition_study`]): deviation and wavelength of the deviation field against the time
+//!    per frame (`partitions.csv` and the four PNGs of the partition study).
 //! 2. The exact KKT methods (constraint-last LDLᵀ, AMD-regularised LDLᵀ, bordered-LLᵀ Schur) at
 //!    16, 64 and 256 regions on the same clip: KKT solve time per step, stored factor entries and
-//!    overhead against the number of multiplier rows 3K (`kkt_vs_regions.csv`,
+//!    overhead against the multiplier rows 3K (`kkt_vs_regions.csv`,
 //!    `overhead_vs_constraints.png`, `solve_ms_vs_constraints.png`).
-//! 3. The box (§6.2, collisions off): penalty stiffness k_p against the exact Lagrange
-//!    multipliers — largest pre-collision constraint residual / L against KKT milliseconds per
-//!    step (`penalty_vs_lagrange.csv`, `penalty_vs_lagrange.png`).
+//! 3. The box (collisions off): penalty stiffness k_p against the exact Lagrange multipliers —
+//!    largest pre-collision residual / L against KKT milliseconds per step
+//!    (`penalty_vs_lagrange.csv`, `penalty_vs_lagrange.png`).
+
+use geom_core::experiment::Report;
+use geom_core::record::{Cell, Recorder, Series};
+use shells::ContactMethod;
+use tracks::experiments::fig6_partitions::{partition_keys, partition_study, record_partitions, PartitionRow, Solvers};
+use tracks::experiments::protocol::{run_pair, track_opts, PairOpts};
+use tracks::presets::{box_setup, frames_for, ShellOptions};
+use tracks::KktMethod;
 
 use crate::error::Result;
-use crate::out::{Cell, CsvWriter, Summary};
-use crate::plot::{LinePlot, Series};
+use crate::out::Summary;
+use crate::record::FileRecorder;
 use crate::registry::BenchCtx;
-use crate::scenes::tracks::{
-    box_setup, frames_for, partition_keys, partition_study, run_pair, track_opts, write_partition_outputs, PairOpts,
-    PartitionRow,
-};
-use tracks::KktMethod;
+
+/// The contact model of every shell in the bench (the shells default).
+const CONTACT: ContactMethod = ContactMethod::Ipc;
+
+/// The fine shell of sweeps 1 and 2 (Xavier, no self-collision) and 3 (the box).
+fn shell() -> ShellOptions {
+    ShellOptions { substeps: 4, self_collision: false, contact: CONTACT }
+}
 
 /// Runs the three sweeps (quick: 16/64/256 regions, 3 frames; KKT methods 3 frames; penalty
 /// 0.2 s with k_p 1e3, 1e5, 1e7. Default: 16 … 1024 regions, 1 s; KKT methods 0.5 s; penalty
@@ -27,25 +38,20 @@ use tracks::KktMethod;
 pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     let (regions, duration): (&[usize], f64) =
         if ctx.quick { (&[16, 64, 256], 0.1) } else { (&[16, 64, 256, 1024], 1.0) };
-    let rows = partition_study(
-        regions,
-        duration,
-        4,
-        false,
-        KktMethod::ConstraintLastLdlt,
-        KktMethod::ConstraintLastLdlt,
-        usize::MAX,
-        0,
-        &ctx.out_dir,
-    )?;
-    write_partition_outputs(&rows, &ctx.out_dir)?;
-    let mut s = Summary::new();
-    partition_keys(&rows, &mut s);
-    s.set("s_per_frame_untracked", rows.iter().map(|r| r.s_per_frame_untracked).sum::<f64>() / rows.len() as f64);
-    s.set("duration_s", duration);
-    kkt_methods(ctx, &mut s)?;
-    penalty_vs_lagrange(ctx, &mut s)?;
-    Ok(s)
+    let mut rec = FileRecorder::new(&ctx.out_dir)?;
+    let cl = KktMethod::ConstraintLastLdlt;
+    let solvers = Solvers { kkt: cl, kkt_large: cl, large_from: usize::MAX, refine_steps: 0 };
+    let rows = partition_study(regions, duration, &shell(), &solvers, &mut rec)?;
+    record_partitions(&rows, &mut rec)?;
+    let mut r = Report::default();
+    partition_keys(&rows, &mut r);
+    let untracked: Vec<f64> = rows.iter().map(|row| row.s_per_frame_untracked).collect();
+    r.timing("s_per_frame_untracked", geom_core::stats::mean(&untracked));
+    r.num("duration_s", duration);
+    kkt_methods(ctx, &mut r, &mut rec)?;
+    penalty_vs_lagrange(ctx, &mut r, &mut rec)?;
+    rec.finish()?;
+    Ok(Summary::from_report(&r))
 }
 
 /// The exact methods compared in sweep 2, with their summary-key names.
@@ -57,76 +63,68 @@ fn exact_methods() -> [(&'static str, KktMethod); 3] {
     ]
 }
 
+fn series(plot: &str, label: &str, axes: (&str, &str), log: (bool, bool), points: Vec<(f64, f64)>) -> Series {
+    Series { plot: plot.into(), label: label.into(), axes: (axes.0.into(), axes.1.into()), log, points }
+}
+
 /// Sweep 2: KKT solve time, factor size and overhead per exact method and region count.
-fn kkt_methods(ctx: &BenchCtx, s: &mut Summary) -> Result<()> {
+fn kkt_methods(ctx: &BenchCtx, r: &mut Report, rec: &mut FileRecorder) -> Result<()> {
     let duration = if ctx.quick { 0.1 } else { 0.5 };
     let regions = [16usize, 64, 256];
-    let dir = ctx.out_dir.join("kkt_methods");
-    crate::out::ensure_dir(&dir)?;
+    let mut runs = FileRecorder::new(&ctx.out_dir.join("kkt_methods"))?;
     let mut all: Vec<(&str, Vec<PartitionRow>)> = Vec::new();
     for (name, m) in exact_methods() {
         let refine = u32::from(matches!(m, KktMethod::AmdRegularizedLdlt { .. }));
-        let rows = partition_study(&regions, duration, 4, false, m, m, usize::MAX, refine, &dir)?;
-        for r in &rows {
-            s.set(&format!("kkt_ms_per_step_{name}_r{}", r.regions), 1e3 * r.solve_s_per_step);
-            s.set(&format!("overhead_pct_{name}_r{}", r.regions), r.overhead_pct);
-            s.set_count(&format!("nnz_l_{name}_r{}", r.regions), r.nnz_l as u64);
-            s.set(&format!("max_residual_pre_{name}_r{}", r.regions), r.r_pre);
+        let solvers = Solvers { kkt: m, kkt_large: m, large_from: usize::MAX, refine_steps: refine };
+        let rows = partition_study(&regions, duration, &shell(), &solvers, &mut runs)?;
+        for row in &rows {
+            let n = row.regions;
+            r.timing(&format!("kkt_ms_per_step_{name}_r{n}"), 1e3 * row.solve_s_per_step);
+            r.timing(&format!("overhead_pct_{name}_r{n}"), row.overhead_pct);
+            r.count(&format!("nnz_l_{name}_r{n}"), row.nnz_l as u64);
+            r.num(&format!("max_residual_pre_{name}_r{n}"), row.r_pre);
         }
         all.push((name, rows));
     }
-    let mut csv = CsvWriter::create(
-        &ctx.out_dir.join("kkt_vs_regions.csv"),
-        &[
-            "method",
-            "regions",
-            "multipliers",
-            "kkt_ms_per_step",
-            "s_per_frame",
-            "overhead_pct",
-            "nnz_l",
-            "r_pre_over_L",
-        ],
-    )?;
-    let (mut over, mut ms) = (
-        LinePlot::new("tracking overhead vs constraint rows (Xavier)", "multiplier rows 3K", "overhead (%)")
-            .log(true, false),
-        LinePlot::new("KKT solve time vs constraint rows (Xavier)", "multiplier rows 3K", "ms per step")
-            .log(true, true),
-    );
+    let header =
+        ["method", "regions", "multipliers", "kkt_ms_per_step", "s_per_frame", "overhead_pct", "nnz_l", "r_pre_over_L"];
+    rec.table("kkt_vs_regions", &header)?;
     for (name, rows) in &all {
-        for r in rows {
-            csv.row(&[
-                Cell::Text(name.to_string()),
-                Cell::Int(r.regions as i64),
-                Cell::Int(3 * r.k as i64),
-                Cell::Num(1e3 * r.solve_s_per_step),
-                Cell::Num(r.s_per_frame),
-                Cell::Num(r.overhead_pct),
-                Cell::Int(r.nnz_l as i64),
-                Cell::Num(r.r_pre),
-            ])?;
+        for row in rows {
+            rec.row(
+                "kkt_vs_regions",
+                &[
+                    Cell::from(*name),
+                    Cell::from(row.regions),
+                    Cell::from(3 * row.k),
+                    Cell::from(1e3 * row.solve_s_per_step),
+                    Cell::from(row.s_per_frame),
+                    Cell::from(row.overhead_pct),
+                    Cell::from(row.nnz_l),
+                    Cell::from(row.r_pre),
+                ],
+            )?;
         }
-        over = over.with(Series::new(*name, rows.iter().map(|r| ((3 * r.k) as f64, r.overhead_pct)).collect()));
-        ms = ms.with(Series::new(*name, rows.iter().map(|r| ((3 * r.k) as f64, 1e3 * r.solve_s_per_step)).collect()));
+        let pts = |f: &dyn Fn(&PartitionRow) -> f64| rows.iter().map(|row| ((3 * row.k) as f64, f(row))).collect();
+        let rows3k = ("multiplier rows 3K", "overhead (%)");
+        rec.series(&series("overhead_vs_constraints", name, rows3k, (true, false), pts(&|x| x.overhead_pct)))?;
+        let ms = ("multiplier rows 3K", "ms per step");
+        rec.series(&series("solve_ms_vs_constraints", name, ms, (true, true), pts(&|x| 1e3 * x.solve_s_per_step)))?;
     }
-    over.write_png(&ctx.out_dir.join("overhead_vs_constraints.png"))?;
-    ms.write_png(&ctx.out_dir.join("solve_ms_vs_constraints.png"))?;
+    runs.finish()?;
     Ok(())
 }
 
 /// Sweep 3: the box with penalty constraints (k_p) against the exact constraint-last LDLᵀ.
-fn penalty_vs_lagrange(ctx: &BenchCtx, s: &mut Summary) -> Result<()> {
+fn penalty_vs_lagrange(ctx: &BenchCtx, r: &mut Report, rec: &mut FileRecorder) -> Result<()> {
     let (duration, ks): (f64, &[f64]) =
         if ctx.quick { (0.2, &[1e3, 1e5, 1e7]) } else { (0.2, &[1e3, 1e4, 1e5, 1e6, 1e7, 1e8]) };
-    let setup = box_setup(4, false)?;
-    let dir = ctx.out_dir.join("penalty");
+    let setup = box_setup(&shell())?;
+    let mut runs = FileRecorder::new(&ctx.out_dir.join("penalty"))?;
     let mut methods: Vec<(String, KktMethod)> = vec![("lagrange".into(), KktMethod::ConstraintLastLdlt)];
     methods.extend(ks.iter().map(|&k| (format!("penalty_{k:e}"), KktMethod::Penalty { stiffness: k })));
-    let mut csv = CsvWriter::create(
-        &ctx.out_dir.join("penalty_vs_lagrange.csv"),
-        &["method", "stiffness", "kkt_ms_per_step", "max_residual_pre_over_L", "s_per_frame"],
-    )?;
+    let header = ["method", "stiffness", "kkt_ms_per_step", "max_residual_pre_over_L", "s_per_frame"];
+    rec.table("penalty_vs_lagrange", &header)?;
     let (mut lag, mut pen) = (Vec::new(), Vec::new());
     for (name, m) in methods {
         let o = PairOpts {
@@ -138,29 +136,23 @@ fn penalty_vs_lagrange(ctx: &BenchCtx, s: &mut Summary) -> Result<()> {
             anchors: None,
             tag: format!("_{name}"),
         };
-        let out = run_pair(&setup, &o, &dir)?;
-        let ms = 1e3 * out.t_kkt / out.steps.max(1) as f64;
-        let r = out.max_r_pre / out.scale;
+        let out = run_pair(&setup, &o, &mut runs)?;
+        let ms = 1e3 * out.solve_s_per_step();
+        let res = out.r_pre();
         let k = if let KktMethod::Penalty { stiffness } = m { stiffness } else { f64::NAN };
-        csv.row(&[
-            Cell::Text(name.clone()),
-            Cell::Num(k),
-            Cell::Num(ms),
-            Cell::Num(r),
-            Cell::Num(out.s_per_frame_tracked()),
-        ])?;
-        s.set(&format!("box_kkt_ms_per_step_{name}"), ms);
-        s.set(&format!("box_max_residual_pre_{name}"), r);
+        let cells = [Cell::from(name.as_str()), Cell::from(k), Cell::from(ms), Cell::from(res)];
+        rec.row("penalty_vs_lagrange", &[&cells[..], &[Cell::from(out.s_per_frame_tracked())]].concat())?;
+        r.timing(&format!("box_kkt_ms_per_step_{name}"), ms);
+        r.num(&format!("box_max_residual_pre_{name}"), res);
         if k.is_nan() {
-            lag.push((ms, r.max(1e-18)))
+            lag.push((ms, res.max(1e-18)))
         } else {
-            pen.push((ms, r.max(1e-18)))
+            pen.push((ms, res.max(1e-18)))
         }
     }
-    LinePlot::new("box: constraint residual vs solve time", "KKT ms per step", "max r_pre / L")
-        .log(true, true)
-        .with(Series::new("penalty k_p", pen))
-        .with(Series::new("Lagrange (constraint-last LDLᵀ)", lag))
-        .write_png(&ctx.out_dir.join("penalty_vs_lagrange.png"))?;
+    let axes = ("KKT ms per step", "max r_pre / L");
+    rec.series(&series("penalty_vs_lagrange", "penalty k_p", axes, (true, true), pen))?;
+    rec.series(&series("penalty_vs_lagrange", "Lagrange (constraint-last LDLᵀ)", axes, (true, true), lag))?;
+    runs.finish()?;
     Ok(())
 }

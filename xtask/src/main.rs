@@ -35,7 +35,6 @@ mod ronpath;
 mod run;
 mod scene;
 mod scene_items;
-mod scenes;
 
 use std::path::PathBuf;
 use std::process::ExitCode;

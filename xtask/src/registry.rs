@@ -79,8 +79,7 @@ pub fn runners() -> Vec<Runner> {
     crate::crates::geom_core::register(&mut v);
     crate::crates::barnet::register(&mut v);
     crate::crates::shells::register(&mut v);
-    crate::scenes::tracks::register(&mut v);
-    crate::scenes::tracks_variants::register(&mut v);
+    crate::crates::tracks::register(&mut v);
     crate::crates::curve_skin::register(&mut v);
     crate::crates::rigging::register(&mut v);
     crate::crates::motion_graph::register(&mut v);

@@ -52,14 +52,6 @@ impl Mode {
         }
     }
 
-    /// Picks one of three values by mode.
-    pub fn pick<T>(self, quick: T, default: T, full: T) -> T {
-        match self {
-            Mode::Quick => quick,
-            Mode::Default => default,
-            Mode::Full => full,
-        }
-    }
 }
 
 /// The envelope every scene file shares.

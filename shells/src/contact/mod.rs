@@ -95,10 +95,21 @@ const CCD_KEEP: f64 = 0.1;
 /// an obstacle) stops at this gap instead of driving it to zero.
 const GAP_FLOOR: f64 = 1e-3;
 
+/// IPC's contact distance d̂ (m), the reach of the barrier: the scene's `thickness` when
+/// positive, else a tenth of the mesh's mean rest edge length `mean_edge` (m) clamped to
+/// [1 mm, 1 cm].
+pub fn contact_distance(thickness: f64, mean_edge: f64) -> f64 {
+    if thickness > 0.0 {
+        thickness
+    } else {
+        (0.1 * mean_edge).clamp(1e-3, 1e-2)
+    }
+}
+
 impl Ipc {
     pub(crate) fn new(mesh: &ShellMesh, effects: &Effects, cs: &CollisionSettings) -> Self {
         let mean_edge = mesh.mean_edge_length();
-        let dhat = if cs.thickness > 0.0 { cs.thickness } else { (0.1 * mean_edge).clamp(1e-3, 1e-2) };
+        let dhat = contact_distance(cs.thickness, mean_edge);
         let n = mesh.n_vertices().max(1);
         let m_avg = mesh.mass.iter().sum::<f64>() / n as f64;
         let g = effects.gravity.map(|g| g.norm()).unwrap_or(0.0).max(1.0);

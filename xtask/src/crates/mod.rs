@@ -21,6 +21,7 @@ pub mod motion_graph;
 pub mod perf_control;
 pub mod rigging;
 pub mod shells;
+pub mod tracks;
 pub mod wrinkles;
 
 /// An experiment of a method crate: `run(&Params, Size, &mut dyn Recorder)`.

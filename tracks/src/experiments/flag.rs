@@ -1,0 +1,72 @@
+//! `tracks/flag` (Bergou et al. 2007 §5.1, Fig. 1): the coarse 35-vertex preview design loop
+//! (20 throw velocities; the first preview that ends stuck on the branch is the guide), then
+//! the 1617-vertex cotton flag tracking the chosen preview through its four quadrants painted
+//! on the guide, beside the same fine flag untracked.
+//!
+//! Keys (besides the common ones of [`PairOut::report`](super::protocol::PairOut::report)):
+//! `deviation_ratio_untracked_over_tracked` (D_c at the end), `deviation_ratio_mean`,
+//! `stuck_preview`, `stuck_previews_of_20`, `preview_total_s`, `preview_vx/vy`,
+//! `tracked_branch_distance_end_m`, `untracked_branch_distance_end_m`, `detail_amplitude_end_m`.
+//!
+//! ```no_run
+//! use geom_core::experiment::Size;
+//! use geom_core::record::NullRecorder;
+//! let text = std::fs::read_to_string("scenes/tracks/flag.ron").unwrap();
+//! #[derive(serde::Deserialize)]
+//! struct File { params: tracks::experiments::flag::Params }
+//! let f: File = ron::from_str(&text).unwrap();
+//! let report = tracks::experiments::flag::run(&f.params, Size::Quick, &mut NullRecorder::default()).unwrap();
+//! println!("{:?}", report.get("deviation_ratio_untracked_over_tracked"));
+//! ```
+
+use geom_core::experiment::{Report, Size, Target};
+use geom_core::record::Recorder;
+
+use super::protocol::{check_residual, check_sanity, run_standard, PairParams};
+use crate::error::Result;
+use crate::metrics::{branch_distance, centroid};
+use crate::presets::{flag_design, flag_setup};
+
+/// The flag's parameters (the RON `params` block).
+pub type Params = PairParams;
+
+/// Simulated time of each coarse preview (s): the whole guide clip.
+pub const PREVIEW_DURATION: f64 = 4.0;
+
+/// Simulated time of each coarse preview at a run size (s): [`PREVIEW_DURATION`], except 0.5 s
+/// at `Size::Tiny` (a smoke run of the pipeline: no preview reaches the branch by then, so the
+/// last design is kept and `stuck_preview` is 0).
+pub fn preview_duration(size: Size) -> f64 {
+    if size == Size::Tiny {
+        0.5
+    } else {
+        PREVIEW_DURATION
+    }
+}
+
+/// Runs the design loop and the tracked/untracked pair.
+pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
+    p.validate("tracks/flag")?;
+    let design = flag_design(preview_duration(size), p.contact)?;
+    let setup = flag_setup(&design, &p.shell(size))?;
+    let (out, mut r) = run_standard(p, size, &setup, false, rec)?;
+    let last = |v: &[f64]| v.last().copied().unwrap_or(f64::NAN);
+    r.num("deviation_ratio_untracked_over_tracked", last(&out.dc_untracked) / last(&out.dc_tracked));
+    r.num("deviation_ratio_mean", geom_core::stats::mean(&out.dc_untracked) / geom_core::stats::mean(&out.dc_tracked));
+    r.count("stuck_preview", design.stuck_flags.iter().any(|&x| x) as u64);
+    r.count("stuck_previews_of_20", design.stuck_flags.iter().filter(|&&x| x).count() as u64);
+    r.timing("preview_total_s", design.preview_s);
+    r.num("preview_vx", design.velocity.0);
+    r.num("preview_vy", design.velocity.1);
+    r.num("tracked_branch_distance_end_m", branch_distance(&centroid(&out.final_tracked)));
+    r.num("untracked_branch_distance_end_m", branch_distance(&centroid(&out.final_untracked)));
+    r.num("detail_amplitude_end_m", last(&out.ad_tracked));
+    r.check(
+        "deviation_ratio_untracked_over_tracked",
+        Target::AtLeast(3.0),
+        "Bergou et al. 2007 §5.1: the tracked flag follows the preview (untracked D_c ≥ 3× tracked)",
+    );
+    check_residual(&mut r, "max_residual_pre");
+    check_sanity(&mut r);
+    Ok(r)
+}
