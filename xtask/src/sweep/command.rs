@@ -72,9 +72,28 @@ pub fn mode_flag(mode: crate::scene::Mode) -> Option<&'static str> {
     }
 }
 
-/// The words of a scene task: `XTASK run SCENE [--quick|--full] --out DIR --resume --set P=V …`.
-pub fn scene_task(xtask: &Path, scene: &Path, mode: crate::scene::Mode, dir: &Path, sets: &[(String, String)]) -> Vec<String> {
-    let mut w = vec![xtask.display().to_string(), "run".into(), scene.display().to_string()];
+/// The binary and, when known, `--scenes DIR` (the built-in scenes this binary found when
+/// planning), so that a task finds them whatever folder it starts in.
+fn head(xtask: &Path, scenes: Option<&Path>) -> Vec<String> {
+    let mut w = vec![xtask.display().to_string()];
+    if let Some(s) = scenes {
+        w.extend(["--scenes".into(), s.display().to_string()]);
+    }
+    w
+}
+
+/// The words of a scene task:
+/// `XTASK [--scenes S] run SCENE [--quick|--full] --out DIR --resume --set P=V …`.
+pub fn scene_task(
+    xtask: &Path,
+    scenes: Option<&Path>,
+    scene: &Path,
+    mode: crate::scene::Mode,
+    dir: &Path,
+    sets: &[(String, String)],
+) -> Vec<String> {
+    let mut w = head(xtask, scenes);
+    w.extend(["run".into(), scene.display().to_string()]);
     w.extend(mode_flag(mode).map(str::to_string));
     w.extend(["--out".into(), dir.display().to_string(), "--resume".into()]);
     for (p, v) in sets {
@@ -83,9 +102,19 @@ pub fn scene_task(xtask: &Path, scene: &Path, mode: crate::scene::Mode, dir: &Pa
     w
 }
 
-/// The words of a bench point: `XTASK bench CRATE [--quick|--full] --sweep K --point I --out DIR --resume`.
-pub fn bench_task(xtask: &Path, krate: &str, mode: crate::scene::Mode, sweep: &str, point: usize, dir: &Path) -> Vec<String> {
-    let mut w = vec![xtask.display().to_string(), "bench".into(), krate.to_string()];
+/// The words of a bench point:
+/// `XTASK [--scenes S] bench CRATE [--quick|--full] --sweep K --point I --out DIR --resume`.
+pub fn bench_task(
+    xtask: &Path,
+    scenes: Option<&Path>,
+    krate: &str,
+    mode: crate::scene::Mode,
+    sweep: &str,
+    point: usize,
+    dir: &Path,
+) -> Vec<String> {
+    let mut w = head(xtask, scenes);
+    w.extend(["bench".into(), krate.to_string()]);
     w.extend(mode_flag(mode).map(str::to_string));
     w.extend([
         "--sweep".into(),

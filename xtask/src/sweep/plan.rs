@@ -134,8 +134,9 @@ impl Plan {
         }
     }
 
-    /// One line per task: the command that runs it, with `xtask` the binary's absolute path.
-    pub fn command_lines(&self, xtask: &Path) -> Vec<String> {
+    /// One line per task: the command that runs it, with `xtask` the binary's absolute path and
+    /// `scenes` the built-in scene folder (absolute) when there is one.
+    pub fn command_lines(&self, xtask: &Path, scenes: Option<&Path>) -> Vec<String> {
         let mode = self.run_mode();
         self.tasks
             .iter()
@@ -145,9 +146,9 @@ impl Plan {
                     Source::Scene { scene, .. } => {
                         let sets: Vec<(String, String)> =
                             self.parameters.iter().cloned().zip(t.values.iter().cloned()).collect();
-                        command::scene_task(xtask, scene, mode, &t.dir, &sets)
+                        command::scene_task(xtask, scenes, scene, mode, &t.dir, &sets)
                     }
-                    Source::Bench { krate, sweep } => command::bench_task(xtask, krate, mode, sweep, i, &t.dir),
+                    Source::Bench { krate, sweep } => command::bench_task(xtask, scenes, krate, mode, sweep, i, &t.dir),
                 };
                 command::join(&words)
             })
@@ -190,7 +191,8 @@ pub fn this_binary() -> Result<PathBuf> {
 /// sweep again keeps the finished tasks.
 pub fn write(plan: &Plan, dir: &Path, force: bool) -> Result<Vec<String>> {
     let xtask = this_binary()?;
-    let lines = plan.command_lines(&xtask);
+    let scenes = crate::paths::scenes_dir().ok().map(|d| d.canonicalize().unwrap_or_else(|_| crate::paths::absolute(&d)));
+    let lines = plan.command_lines(&xtask, scenes.as_deref());
     let text = lines.join("\n") + "\n";
     let tasks_txt = dir.join(TASKS_TXT);
     if let Ok(old) = std::fs::read_to_string(&tasks_txt) {

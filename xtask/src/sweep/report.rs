@@ -147,7 +147,7 @@ pub fn html(h: &mut String, report_dir: &Path, root: &Path) {
                 let rel = relative(report_dir, p);
                 let _ = writeln!(
                     h,
-                    "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\" loading=\"lazy\"></a><figcaption>{1}</figcaption></figure>",
+                    "<figure><a href=\"{0}\"><img src=\"{0}\" alt=\"{1}\"></a><figcaption>{1}</figcaption></figure>",
                     esc(&rel),
                     esc(&name)
                 );

@@ -63,15 +63,15 @@ fn sweep_file_gives_tasks_with_absolute_self_contained_commands() {
     let plan = Plan::from_file(&sf, &dir.join("out"));
     assert_eq!(plan.tasks.len(), 4);
     assert_eq!(plan.tasks[1].values, s(&["0.1", "None"]));
-    let lines = plan.command_lines(Path::new("/opt/tk/bin/xtask"));
+    let lines = plan.command_lines(Path::new("/opt/tk/bin/xtask"), Some(Path::new("/opt/tk/scenes")));
     let w = split(&lines[2]).unwrap();
-    assert_eq!(w[0], "/opt/tk/bin/xtask");
-    assert_eq!(&w[1..2], ["run"]);
-    assert_eq!(PathBuf::from(&w[2]), sf.scene);
+    assert_eq!(&w[..4], ["/opt/tk/bin/xtask", "--scenes", "/opt/tk/scenes", "run"]);
+    let w = &w[3..];
+    assert_eq!(PathBuf::from(&w[1]), sf.scene);
     let out = dir.join("out/tasks/0002");
     let expect = s(&["--quick", "--out", &out.display().to_string(), "--resume"]);
-    assert_eq!(&w[3..7], &expect[..]);
-    assert_eq!(&w[7..], &s(&["--set", "shell.material.density=0.2", "--set", "shell.effects.gravity=Some((0.0, -9.81, 0.0))"])[..]);
+    assert_eq!(&w[2..6], &expect[..]);
+    assert_eq!(&w[6..], &s(&["--set", "shell.material.density=0.2", "--set", "shell.effects.gravity=Some((0.0, -9.81, 0.0))"])[..]);
     // The plan round-trips through sweep.ron.
     let text = ron::ser::to_string_pretty(&plan, ron::ser::PrettyConfig::default()).unwrap();
     assert_eq!(ron::from_str::<Plan>(&text).unwrap(), plan);
