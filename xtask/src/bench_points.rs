@@ -69,7 +69,10 @@ pub fn flip_tet_cfl(quick: bool) -> Vec<f64> {
 
 /// perf-control `rate`: (working rate Hz, factor); the 30 Hz point is left out of quick sweeps.
 pub fn perf_control_rate(quick: bool) -> Vec<(f64, usize)> {
-    [(5.0, 6usize), (7.5, 4), (10.0, 3), (15.0, 2), (30.0, 1)].into_iter().filter(|&(_, f)| !(quick && f == 1)).collect()
+    [(5.0, 6usize), (7.5, 4), (10.0, 3), (15.0, 2), (30.0, 1)]
+        .into_iter()
+        .filter(|&(_, f)| !(quick && f == 1))
+        .collect()
 }
 
 /// perf-control `stretch`: stretch limit (s).

@@ -449,7 +449,14 @@ fn plan(
     };
     let lines = sweep::plan::write(&p, &dir, force)?;
     let finished = p.tasks.iter().filter(|t| sweep::task::state(&t.dir) == sweep::task::TaskState::Finished).count();
-    say!("plan {}: {} tasks over {} ({} mode) → {}", p.name(), lines.len(), p.parameters.join(" × "), p.mode, dir.display());
+    say!(
+        "plan {}: {} tasks over {} ({} mode) → {}",
+        p.name(),
+        lines.len(),
+        p.parameters.join(" × "),
+        p.mode,
+        dir.display()
+    );
     say!("  {}", dir.join(sweep::plan::TASKS_TXT).display());
     say!("  {}", dir.join(sweep::plan::SWEEP_RON).display());
     say!("  {}", dir.join(sweep::openjd::FILE).display());

@@ -292,10 +292,17 @@ pub fn run_bench(crate_name: &str, sweep: Option<&str>, point: Option<usize>, o:
             Error::Usage(format!("--point {i} needs --sweep <knob> (one of: {})", bench.sweeps.join(", ")))
         })?;
         let n = crate::bench_points::points(crate_name, k, o.mode == Mode::Quick)
-            .ok_or_else(|| Error::Usage(format!("the '{k}' sweep of the '{crate_name}' benchmark does not split into points; run it whole")))?
+            .ok_or_else(|| {
+                Error::Usage(format!(
+                    "the '{k}' sweep of the '{crate_name}' benchmark does not split into points; run it whole"
+                ))
+            })?
             .len();
         if i >= n {
-            return Err(Error::Usage(format!("--point {i}: the '{k}' sweep of '{crate_name}' has {n} points (0 … {})", n - 1)));
+            return Err(Error::Usage(format!(
+                "--point {i}: the '{k}' sweep of '{crate_name}' has {n} points (0 … {})",
+                n - 1
+            )));
         }
     }
     prepare_dir(&o.out_dir, o.policy)?;

@@ -134,7 +134,10 @@ pub fn merge_bench_tables(dir: &Path, plan: &Plan, c: &Collected) -> Result<Vec<
             match &header {
                 None => header = Some(h),
                 Some(h0) if *h0 != h => {
-                    return Err(Error::Run(format!("{}: its header differs from the other points' {name}", p.display())))
+                    return Err(Error::Run(format!(
+                        "{}: its header differs from the other points' {name}",
+                        p.display()
+                    )))
                 }
                 Some(_) => {}
             }
@@ -158,7 +161,8 @@ pub fn collect(dir: &Path) -> Result<Collected> {
     let c = gather(&plan)?;
     let csv = dir.join(SWEEP_CSV);
     write_csv(&csv, &plan, &c)?;
-    let tables = if matches!(plan.source, Source::Bench { .. }) { merge_bench_tables(&dir, &plan, &c)? } else { Vec::new() };
+    let tables =
+        if matches!(plan.source, Source::Bench { .. }) { merge_bench_tables(&dir, &plan, &c)? } else { Vec::new() };
     let status = serde_json::json!({
         "name": plan.name(),
         "tasks": plan.tasks.len(),

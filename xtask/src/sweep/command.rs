@@ -6,8 +6,7 @@ use std::path::Path;
 /// `s` quoted for a POSIX shell: unchanged when it holds only characters no shell treats
 /// specially, else in single quotes (a `'` inside becomes `'\''`).
 pub fn shell_quote(s: &str) -> String {
-    let plain = !s.is_empty()
-        && s.chars().all(|c| c.is_ascii_alphanumeric() || "_-+=./:,@%^".contains(c));
+    let plain = !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "_-+=./:,@%^".contains(c));
     if plain {
         s.to_string()
     } else {

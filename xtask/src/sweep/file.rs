@@ -101,7 +101,12 @@ pub fn parse(file: &Path, text: &str) -> Result<SweepFile> {
     for (k, (path, values)) in raw.vary.iter().enumerate() {
         let here = vec![field("vary"), Seg::Index(k)];
         if values.is_empty() {
-            return Err(at(file, text, &[here.clone(), vec![Seg::Index(1)]].concat(), format!("`{path}` has no values")));
+            return Err(at(
+                file,
+                text,
+                &[here.clone(), vec![Seg::Index(1)]].concat(),
+                format!("`{path}` has no values"),
+            ));
         }
         if vary.iter().any(|d| &d.path == path) {
             return Err(at(file, text, &here, format!("`{path}` is listed twice")));

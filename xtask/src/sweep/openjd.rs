@@ -32,9 +32,7 @@ pub fn yaml_str(s: &str) -> String {
 pub fn template(plan: &Plan, dir: &Path, xtask: &Path) -> String {
     let tasks = super::command::shell_quote(&dir.join(TASKS_TXT).display().to_string());
     // Runs line {{Task.Param.Line}} of tasks.txt; a missing line is an error, not a silent success.
-    let script = format!(
-        "line=$(sed -n '{{{{Task.Param.Line}}}}p' {tasks}) && test -n \"$line\" && eval \"$line\""
-    );
+    let script = format!("line=$(sed -n '{{{{Task.Param.Line}}}}p' {tasks}) && test -n \"$line\" && eval \"$line\"");
     let n = plan.tasks.len().max(1);
     let range = if n == 1 { "1".to_string() } else { format!("1-{n}") };
     format!(

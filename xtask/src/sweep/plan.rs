@@ -191,7 +191,8 @@ pub fn this_binary() -> Result<PathBuf> {
 /// sweep again keeps the finished tasks.
 pub fn write(plan: &Plan, dir: &Path, force: bool) -> Result<Vec<String>> {
     let xtask = this_binary()?;
-    let scenes = crate::paths::scenes_dir().ok().map(|d| d.canonicalize().unwrap_or_else(|_| crate::paths::absolute(&d)));
+    let scenes =
+        crate::paths::scenes_dir().ok().map(|d| d.canonicalize().unwrap_or_else(|_| crate::paths::absolute(&d)));
     let lines = plan.command_lines(&xtask, scenes.as_deref());
     let text = lines.join("\n") + "\n";
     let tasks_txt = dir.join(TASKS_TXT);

@@ -95,18 +95,15 @@ fn view(dir: &Path, root: &Path) -> Option<View> {
     };
     let finished = st.as_ref().and_then(|s| s.get("finished")).and_then(|v| v.as_u64()).unwrap_or(0);
     let (failed, missing) = (list("failed"), list("missing"));
-    let mut status = format!("{} tasks: {finished} finished, {} failed, {} missing", plan.tasks.len(), failed.len(), missing.len());
+    let mut status =
+        format!("{} tasks: {finished} finished, {} failed, {} missing", plan.tasks.len(), failed.len(), missing.len());
     if !failed.is_empty() {
         let _ = write!(status, "; failed: {}", failed.join(", "));
     }
     if !missing.is_empty() {
         let _ = write!(status, "; missing: {}", missing.join(", "));
     }
-    let csv = std::fs::read_to_string(dir.join(SWEEP_CSV))
-        .unwrap_or_default()
-        .lines()
-        .map(csv_fields)
-        .collect();
+    let csv = std::fs::read_to_string(dir.join(SWEEP_CSV)).unwrap_or_default().lines().map(csv_fields).collect();
     let mut links: Vec<(PathBuf, String)> = [SWEEP_CSV, TASKS_TXT, SWEEP_RON, super::openjd::FILE, STATUS_JSON]
         .iter()
         .map(|n| (dir.join(n), n.to_string()))
@@ -141,7 +138,8 @@ pub fn html(h: &mut String, report_dir: &Path, root: &Path) {
         }
         h.push_str("</table></div></details>\n");
         if !v.plots.is_empty() {
-            let _ = writeln!(h, "<details><summary>{} plots: each figure against each parameter</summary>", v.plots.len());
+            let _ =
+                writeln!(h, "<details><summary>{} plots: each figure against each parameter</summary>", v.plots.len());
             for p in &v.plots {
                 let name = p.file_name().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
                 let rel = relative(report_dir, p);

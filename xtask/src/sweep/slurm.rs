@@ -135,7 +135,11 @@ pub fn submit(tasks_txt: &Path, o: &SlurmOpts, submit: bool) -> Result<()> {
     args.extend(o.flags());
     args.extend(["--wrap".into(), collect]);
     let collect_id = sbatch(&args)?;
-    say!("array job: {array} ({} tasks{})", todo.len(), o.throttle.map(|k| format!(", at most {k} at once")).unwrap_or_default());
+    say!(
+        "array job: {array} ({} tasks{})",
+        todo.len(),
+        o.throttle.map(|k| format!(", at most {k} at once")).unwrap_or_default()
+    );
     say!("collect job: {collect_id} (after the array ends; writes {})", dir.join("sweep.csv").display());
     Ok(())
 }

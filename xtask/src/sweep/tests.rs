@@ -71,7 +71,10 @@ fn sweep_file_gives_tasks_with_absolute_self_contained_commands() {
     let out = dir.join("out/tasks/0002");
     let expect = s(&["--quick", "--out", &out.display().to_string(), "--resume"]);
     assert_eq!(&w[2..6], &expect[..]);
-    assert_eq!(&w[6..], &s(&["--set", "shell.material.density=0.2", "--set", "shell.effects.gravity=Some((0.0, -9.81, 0.0))"])[..]);
+    assert_eq!(
+        &w[6..],
+        &s(&["--set", "shell.material.density=0.2", "--set", "shell.effects.gravity=Some((0.0, -9.81, 0.0))"])[..]
+    );
     // The plan round-trips through sweep.ron.
     let text = ron::ser::to_string_pretty(&plan, ron::ser::PrettyConfig::default()).unwrap();
     assert_eq!(ron::from_str::<Plan>(&text).unwrap(), plan);
@@ -89,7 +92,8 @@ fn bad_sweep_files_name_file_line_and_field() {
     let e = err(&drape_sweep("        (\"shell.material.density\", []),"));
     assert!(e.starts_with("/work/my-sweep.ron:5:") && e.contains("has no values"), "{e}");
     // Listed twice.
-    let e = err(&drape_sweep("        (\"shell.material.density\", [0.1]),\n        (\"shell.material.density\", [0.2]),"));
+    let e =
+        err(&drape_sweep("        (\"shell.material.density\", [0.1]),\n        (\"shell.material.density\", [0.2]),"));
     assert!(e.starts_with("/work/my-sweep.ron:6:") && e.contains("listed twice"), "{e}");
     // An unknown scene: the `scene` line.
     let e = err("(\n    scene: \"shells/nope\",\n    vary: [(\"a\", [1])],\n)\n");
@@ -113,7 +117,11 @@ fn fake_plan(dir: &Path, n: usize) -> Plan {
         mode: "quick".into(),
         parameters: s(&["stretch"]),
         tasks: (0..n)
-            .map(|i| PlanTask { id: task_id(i, n), dir: dir.join("tasks").join(task_id(i, n)), values: vec![format!("0.{i}")] })
+            .map(|i| PlanTask {
+                id: task_id(i, n),
+                dir: dir.join("tasks").join(task_id(i, n)),
+                values: vec![format!("0.{i}")],
+            })
             .collect(),
     }
 }
@@ -123,7 +131,8 @@ fn finish(t: &PlanTask, err: f64, wall: f64) {
     s.set("err_rms_m", err).set("wall_s", wall).set_str("mode", "quick").set("nan_figure", f64::NAN);
     s.write(&t.dir).unwrap();
     std::fs::write(t.dir.join("timing.json"), "[\"wall_s\"]\n").unwrap();
-    std::fs::write(t.dir.join("pc_stretch.csv"), format!("sweep,value,dp_s\nstretch,{},{wall}\n", t.values[0])).unwrap();
+    std::fs::write(t.dir.join("pc_stretch.csv"), format!("sweep,value,dp_s\nstretch,{},{wall}\n", t.values[0]))
+        .unwrap();
 }
 
 #[test]
@@ -161,7 +170,10 @@ fn collect_merges_summaries_with_parameters_in_task_order() {
     assert_eq!(c.timing, ["wall_s"]);
     write_csv(&dir.join("sweep.csv"), &plan, &c).unwrap();
     let text = std::fs::read_to_string(dir.join("sweep.csv")).unwrap();
-    assert_eq!(text, "task,stretch,err_rms_m,mode,nan_figure,wall_s\n0000,0.0,0.5,quick,NaN,1.5\n0002,0.2,0.125,quick,NaN,3.0\n");
+    assert_eq!(
+        text,
+        "task,stretch,err_rms_m,mode,nan_figure,wall_s\n0000,0.0,0.5,quick,NaN,1.5\n0002,0.2,0.125,quick,NaN,3.0\n"
+    );
     // The whole collect: status, bench table concatenated in task order, report with the sweep.
     std::fs::write(dir.join("sweep.ron"), ron::ser::to_string_pretty(&plan, Default::default()).unwrap()).unwrap();
     collect(&dir).unwrap();
@@ -174,7 +186,10 @@ fn collect_merges_summaries_with_parameters_in_task_order() {
     assert!(dir.join("plots/err_rms_m--stretch.png").is_file());
     assert!(!dir.join("plots/mode--stretch.png").exists(), "text figures are not plotted");
     let html = std::fs::read_to_string(dir.join("report/index.html")).unwrap();
-    assert!(html.contains("sweep bench-perf-control-stretch") && html.contains("failed: 0001"), "report shows the sweep");
+    assert!(
+        html.contains("sweep bench-perf-control-stretch") && html.contains("failed: 0001"),
+        "report shows the sweep"
+    );
     assert!(html.contains("<td>0.125</td>"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -188,7 +203,12 @@ fn slurm_array_lists_only_the_unfinished_lines() {
     assert_eq!(parse_job_id("sbatch: error"), None);
     let dir = PathBuf::from("/scratch/sw");
     let plan = fake_plan(&dir, 16);
-    let o = SlurmOpts { partition: Some("short".into()), time: Some("0:10:00".into()), mem: Some("2G".into()), throttle: Some(4) };
+    let o = SlurmOpts {
+        partition: Some("short".into()),
+        time: Some("0:10:00".into()),
+        mem: Some("2G".into()),
+        throttle: Some(4),
+    };
     let text = script(&plan, &dir, &[0, 1, 2, 3, 9], &o);
     assert!(text.contains("#SBATCH --array=0-3,9%4\n"), "{text}");
     assert!(text.contains("#SBATCH --partition=short\n#SBATCH --time=0:10:00\n#SBATCH --mem=2G\n"), "{text}");
@@ -212,4 +232,52 @@ fn openjd_template_has_one_task_per_line_and_a_collect_step() {
 fn csv_fields_read_quoted_cells() {
     use super::report::csv_fields;
     assert_eq!(csv_fields("a,\"b,c\",\"x\"\"y\","), s(&["a", "b,c", "x\"y", ""]));
+}
+
+#[test]
+fn bench_points_are_checked_before_anything_runs() {
+    use crate::run::{run_bench, DirPolicy, RunOptions};
+    use crate::scene::Mode;
+    let dir = tmp("points");
+    let o = RunOptions {
+        mode: Mode::Quick,
+        out_dir: dir.join("run"),
+        policy: DirPolicy::Explicit { force: false },
+        overrides: Vec::new(),
+        previews: false,
+        label: "t".into(),
+    };
+    let e = run_bench("flip-tet", Some("resolution"), Some(2), &o).unwrap_err().to_string();
+    assert!(e.contains("has 2 points"), "{e}");
+    let e = run_bench("flip-tet", Some("solver"), Some(0), &o).unwrap_err().to_string();
+    assert!(e.contains("does not split"), "{e}");
+    let e = run_bench("flip-tet", Some("all"), Some(0), &o).unwrap_err().to_string();
+    assert!(e.contains("needs --sweep"), "{e}");
+    assert!(!o.out_dir.exists(), "nothing ran");
+    let e = Plan::from_bench("perf-control", "beam", Mode::Quick, &dir).unwrap_err().to_string();
+    assert!(e.contains("does not split"), "{e}");
+    let e = Plan::from_bench("flip-tet", "nope", Mode::Quick, &dir).unwrap_err().to_string();
+    assert!(e.contains("no sweep 'nope'") && e.contains("resolution"), "{e}");
+    let p = Plan::from_bench("flip-tet", "resolution", Mode::Full, &dir).unwrap();
+    assert_eq!(p.tasks.iter().map(|t| t.values[0].as_str()).collect::<Vec<_>>(), ["16", "32", "64"]);
+    let lines = p.command_lines(Path::new("/b/xtask"), None);
+    let w = split(&lines[1]).unwrap();
+    let out = dir.join("tasks/0001").display().to_string();
+    assert_eq!(
+        w,
+        s(&[
+            "/b/xtask",
+            "bench",
+            "flip-tet",
+            "--full",
+            "--sweep",
+            "resolution",
+            "--point",
+            "1",
+            "--out",
+            &out,
+            "--resume"
+        ])
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }
