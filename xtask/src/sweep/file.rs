@@ -94,6 +94,7 @@ pub fn parse(file: &Path, text: &str) -> Result<SweepFile> {
         crate::registry::resolve_target(&raw.scene).map_err(|e| at(file, text, &scene_path, e))?.1
     };
     let scene_text = std::fs::read_to_string(&scene).map_err(io_err(&scene))?;
+    let header = scene::load_header(&scene)?;
     if raw.vary.is_empty() {
         return Err(at(file, text, &[field("vary")], "lists no parameter: add (\"path.to.field\", [values])"));
     }
@@ -120,9 +121,29 @@ pub fn parse(file: &Path, text: &str) -> Result<SweepFile> {
             texts.push(ov.value);
         }
         // The path must exist in the scene (or be addable to its parent), as `--set` requires.
+        let first = [here.clone(), vec![Seg::Index(0)]].concat();
         let ov = Override { path: path.clone(), value: texts[0].clone() };
-        scene::apply_overrides(&scene, &scene_text, &[ov])
-            .map_err(|e| at(file, text, &[here.clone(), vec![Seg::Index(0)]].concat(), e))?;
+        scene::apply_overrides(&scene, &scene_text, &[ov]).map_err(|e| at(file, text, &first, e))?;
+        // A field the scene does not write is added by the override; catch a misspelt name here
+        // rather than in every task: it must be a field of some parameter struct of the crate.
+        let mut full = vec![field("params")];
+        full.extend(ronpath::parse_path(path));
+        let written = ronpath::find(&ronpath::outline(&scene_text), &full).is_some();
+        if let (false, Some(Seg::Field(leaf))) = (written, full.last()) {
+            let krate = header.method.split('/').next().unwrap_or_default();
+            if crate::params::is_field_of_crate(krate, leaf) == Some(false) {
+                return Err(at(
+                    file,
+                    text,
+                    &first,
+                    format!(
+                        "`{path}`: {} does not write `{leaf}` and no parameter of {krate} is called so                          (`cargo xtask params {}` lists them)",
+                        scene.display(),
+                        header.method
+                    ),
+                ));
+            }
+        }
         vary.push(Dim { path: path.clone(), values: texts });
     }
     let mode = match raw.mode {
