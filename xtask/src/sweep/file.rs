@@ -45,7 +45,7 @@ pub struct SweepFile {
 }
 
 #[derive(Deserialize)]
-enum RawMode {
+enum SweepMode {
     Quick,
     Default,
     Full,
@@ -56,12 +56,12 @@ enum RawMode {
 struct Raw {
     scene: String,
     #[serde(default = "default_mode")]
-    mode: RawMode,
+    mode: SweepMode,
     vary: Vec<(String, Vec<IgnoredAny>)>,
 }
 
-fn default_mode() -> RawMode {
-    RawMode::Default
+fn default_mode() -> SweepMode {
+    SweepMode::Default
 }
 
 /// An error at `path` of the sweep file (its line and column), naming the field.
@@ -147,9 +147,9 @@ pub fn parse(file: &Path, text: &str) -> Result<SweepFile> {
         vary.push(Dim { path: path.clone(), values: texts });
     }
     let mode = match raw.mode {
-        RawMode::Quick => Mode::Quick,
-        RawMode::Default => Mode::Default,
-        RawMode::Full => Mode::Full,
+        SweepMode::Quick => Mode::Quick,
+        SweepMode::Default => Mode::Default,
+        SweepMode::Full => Mode::Full,
     };
     Ok(SweepFile { file: crate::paths::absolute(file), scene, mode, vary })
 }
