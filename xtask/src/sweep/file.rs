@@ -137,7 +137,7 @@ pub fn parse(file: &Path, text: &str) -> Result<SweepFile> {
                     text,
                     &first,
                     format!(
-                        "`{path}`: {} does not write `{leaf}` and no parameter of {krate} is called so                          (`cargo xtask params {}` lists them)",
+                        "`{path}`: {} does not write `{leaf}` and no parameter of {krate} is called so (`cargo xtask params {}` lists them)",
                         scene.display(),
                         header.method
                     ),
