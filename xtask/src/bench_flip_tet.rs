@@ -10,6 +10,7 @@ use flip_tet::reference::MARTIN_MOYCE_FRONT;
 use flip_tet::scene::Scene;
 use geom_core::experiment::Size;
 
+use crate::bench_points::{self as P, pts};
 use crate::error::{Error, Result};
 use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
@@ -91,7 +92,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     for knob in &selected {
         match *knob {
             "resolution" => {
-                for n in if b.quick { vec![16, 32] } else { vec![16, 32, 64] } {
+                for n in pts(ctx, P::flip_tet_resolution(b.quick)) {
                     let mut s = b.dam.clone();
                     s.resolution.finest = n;
                     let (rms, w, st, p, _) = b.dam(&s, &format!("res_{n}"))?;
@@ -100,8 +101,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 }
             }
             "levels" => {
-                let finest = if b.quick { 32 } else { 64 };
-                for coarsest in [finest, finest / 2, 8] {
+                for (coarsest, finest) in pts(ctx, P::flip_tet_levels(b.quick)) {
                     let mut s = b.dam.clone();
                     (s.resolution.finest, s.resolution.coarsest) = (finest, coarsest);
                     let (rms, w, st, p, _) = b.dam(&s, &format!("levels_{coarsest}"))?;
@@ -109,10 +109,10 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 }
             }
             "tol" => {
-                let tols: &[f64] = if b.quick { &[1e-2, 1e-6] } else { &[1e-2, 1e-3, 1e-4, 1e-6, 1e-8] };
-                let mut v: Vec<(String, SolverKind, f64)> = vec![("direct".into(), SolverKind::DirectCholesky, 1e-6)];
-                v.extend(tols.iter().map(|&t| (format!("mic_pcg_{t:e}"), SolverKind::PcgIc0, t)));
-                for (name, kind, tol) in v {
+                let mut v: Vec<(SolverKind, f64)> = vec![(SolverKind::DirectCholesky, 1e-6)];
+                v.extend(P::flip_tet_tols(b.quick).iter().map(|&t| (SolverKind::PcgIc0, t)));
+                let named = P::flip_tet_tol_names(b.quick).into_iter().zip(v).collect();
+                for (name, (kind, tol)) in pts(ctx, named) {
                     let mut s = b.pool.clone();
                     (s.pressure.solver, s.pressure.tol) = (kind, tol);
                     let r = b.sim(&s, &format!("tol_{name}"))?;
@@ -123,7 +123,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 }
             }
             "bc" => {
-                for (second, tag) in [(true, "second"), (false, "first")] {
+                for (second, tag) in pts(ctx, P::FLIP_TET_BC.to_vec()) {
                     let mut s = b.dam.clone();
                     (s.resolution.finest, s.pressure.second_order) = (32, second);
                     let (rms, w, st, p, _) = b.dam(&s, &format!("bc_{tag}"))?;
@@ -142,7 +142,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
             }
             "solver" => sweep_solver(&mut b, &ctx.out_dir)?,
             "remesh" => {
-                for k in if b.quick { vec![1, 10] } else { vec![1, 5, 10, 20] } {
+                for k in pts(ctx, P::flip_tet_remesh(b.quick)) {
                     let mut s = b.dam.clone();
                     (s.resolution.finest, s.flip.remesh_interval) = (32, k);
                     let (rms, w, st, p, _) = b.dam(&s, &format!("remesh_{k}"))?;
@@ -152,7 +152,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 }
             }
             "cfl" => {
-                for cfl in if b.quick { vec![0.5, 2.0] } else { vec![0.5, 1.0, 2.0, 4.0] } {
+                for cfl in pts(ctx, P::flip_tet_cfl(b.quick)) {
                     let mut s = b.dam.clone();
                     (s.resolution.finest, s.flip.cfl, s.flip.dt_max) = (32, cfl, 1.0 / b.dam.fps);
                     let (rms, w, st, p, drift) = b.dam(&s, &format!("cfl_{cfl}"))?;

@@ -19,6 +19,7 @@
 use perf_control::experiments::sweeps::{evaluate, evaluate_dance, DanceSweep, SweepPoint, WalkSweep};
 use perf_control::{ClusterDistance, DpParams};
 
+use crate::bench_points::{self as P, pts};
 use crate::error::{Error, Result};
 use crate::out::{Cell, CsvWriter, Summary};
 use crate::plot::{LinePlot, Series};
@@ -106,10 +107,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 ("DP time (s)", "relative score excess (floored at 1e-9)")
             }
             "rate" => {
-                for (hz, f) in [(5.0, 6usize), (7.5, 4), (10.0, 3), (15.0, 2), (30.0, 1)] {
-                    if s.quick && f == 1 {
-                        continue;
-                    }
+                for (hz, f) in pts(ctx, P::perf_control_rate(s.quick)) {
                     let r = evaluate(&s, f, Some(size), cat, &beam)?;
                     row(&mut csv, &r, "rate", hz, "beam0.3", f64::NAN)?;
                     add("refined (30 Hz skeleton)", (r.dp_s, r.rms));
@@ -134,7 +132,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 ("DP time (s)", "tracking RMS (m)")
             }
             "stretch" => {
-                for lim in [0.0, 0.1, 0.15, 0.2, 0.3] {
+                for lim in pts(ctx, P::PERF_CONTROL_STRETCH.to_vec()) {
                     let r = evaluate(&s, 3, Some(size), cat, &DpParams { stretch_limit_s: lim, ..beam.clone() })?;
                     row(&mut csv, &r, "stretch", lim, "beam0.3", f64::NAN)?;
                     add("stretch limits", (r.dp_s, r.rms));
@@ -142,7 +140,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
                 ("DP time (s)", "tracking RMS (m)")
             }
             _ => {
-                for k in [0.0, 1.0, 3.0, 10.0, 30.0, 100.0] {
+                for k in pts(ctx, P::PERF_CONTROL_K.to_vec()) {
                     let r = evaluate(&s, 3, Some(size), cat, &DpParams { k, ..beam.clone() })?;
                     row(&mut csv, &r, "k", k, "beam0.3", f64::NAN)?;
                     add("tracking RMS (m)", (k, r.rms));

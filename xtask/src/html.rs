@@ -238,6 +238,7 @@ pub fn write(report_dir: &Path, root: &Path, runs: &[RunInfo], wall_s: Option<f6
         );
     }
     h.push_str("</table>\n");
+    crate::sweep::report::html(&mut h, report_dir, root);
     for r in runs {
         run_section(&mut h, report_dir, r)?;
     }

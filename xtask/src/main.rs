@@ -12,6 +12,7 @@ mod bench_flip_tet;
 mod bench_geom_core;
 mod bench_motion_graph;
 mod bench_perf_control;
+mod bench_points;
 mod bench_rigging;
 mod bench_shells;
 mod bench_tracks;
@@ -35,6 +36,7 @@ mod ronpath;
 mod run;
 mod scene;
 mod scene_items;
+mod sweep;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -76,6 +78,10 @@ enum Cmd {
         /// Clear a non-empty --out folder first.
         #[arg(long)]
         force: bool,
+        /// With --out: succeed at once when DIR holds a finished run (summary.json, no FAILED);
+        /// otherwise clear DIR and run (what a sweep's task lines use).
+        #[arg(long, requires = "out", conflicts_with = "force")]
+        resume: bool,
         /// Override a parameter: a path inside the scene's params block and a RON value, e.g.
         /// --set shell.material.density=0.2 (repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
@@ -107,6 +113,14 @@ enum Cmd {
         /// cfl, pic, surface; or all).
         #[arg(long, value_name = "KNOB")]
         sweep: Option<String>,
+        /// Run only the I-th point (from 0) of the --sweep (the sweeps whose points are
+        /// independent: flip-tet resolution, levels, tol, bc, remesh, cfl; perf-control rate,
+        /// stretch, k).
+        #[arg(long, value_name = "I", requires = "sweep")]
+        point: Option<usize>,
+        /// With --out: succeed at once when DIR holds a finished run; otherwise clear it and run.
+        #[arg(long, requires = "out", conflicts_with = "force")]
+        resume: bool,
         /// Override a parameter of the scene files the bench reads (PATH=VALUE, repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         set: Vec<String>,
@@ -185,11 +199,80 @@ enum Cmd {
         #[arg(required = true)]
         dirs: Vec<PathBuf>,
     },
+    /// Plans a sweep: DIR/tasks.txt (one self-contained command per task), DIR/sweep.ron (task →
+    /// parameters) and DIR/sweep.openjd.yaml, from a sweep file or a benchmark's sweep.
+    Plan {
+        /// A sweep file (.ron: scene, mode, vary).
+        #[arg(required_unless_present = "bench", conflicts_with = "bench")]
+        file: Option<PathBuf>,
+        /// Plan the points of this crate's benchmark sweep instead (with --sweep).
+        #[arg(long, value_name = "CRATE", requires = "sweep")]
+        bench: Option<String>,
+        /// The benchmark's sweep (e.g. resolution).
+        #[arg(long, value_name = "KNOB", requires = "bench")]
+        sweep: Option<String>,
+        /// Bench points at quick size.
+        #[arg(long, conflicts_with = "full", requires = "bench")]
+        quick: bool,
+        /// Bench points at full size.
+        #[arg(long, requires = "bench")]
+        full: bool,
+        /// The sweep folder.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Replace another sweep planned in DIR (its tasks/ are removed).
+        #[arg(long)]
+        force: bool,
+    },
+    /// Runs, submits or collects a planned sweep.
+    Sweep {
+        #[command(subcommand)]
+        cmd: SweepCmd,
+    },
     /// Builds OUT_DIR/report/index.html (and index.md) from the runs found in OUT_DIR at any
     /// depth (folders with summary.json or FAILED).
     Report {
         /// The folder to collect (default out/).
         out_dir: Option<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum SweepCmd {
+    /// Runs the unfinished tasks of DIR/tasks.txt on this machine, N at a time.
+    Run {
+        /// DIR/tasks.txt of `plan`.
+        tasks: PathBuf,
+        /// Concurrent processes.
+        #[arg(short = 'j', long, default_value_t = 1)]
+        jobs: usize,
+    },
+    /// Writes DIR/sweep.sbatch (a job array of the unfinished tasks) and submits it with a
+    /// dependent job that collects the results.
+    Slurm {
+        /// DIR/tasks.txt of `plan`.
+        tasks: PathBuf,
+        /// Slurm partition.
+        #[arg(long)]
+        partition: Option<String>,
+        /// Time limit per task (Slurm syntax, e.g. 0:30:00).
+        #[arg(long)]
+        time: Option<String>,
+        /// Memory per task (Slurm syntax, e.g. 4G).
+        #[arg(long)]
+        mem: Option<String>,
+        /// At most K tasks at once (the array's %K).
+        #[arg(long, value_name = "K")]
+        throttle: Option<usize>,
+        /// Write sweep.sbatch but do not submit.
+        #[arg(long)]
+        no_submit: bool,
+    },
+    /// Merges every finished task's summary.json with its parameters into DIR/sweep.csv, plots
+    /// each figure against each parameter, and rebuilds DIR/report/index.html.
+    Collect {
+        /// The sweep folder.
+        dir: PathBuf,
     },
 }
 
@@ -214,12 +297,36 @@ fn main() -> ExitCode {
     }
     let result = match cli.cmd {
         Cmd::List => list(),
-        Cmd::Run { target, quick, full, out, force, set, verbose, no_preview } => {
-            overrides(&set).and_then(|ovs| run_one(&target, mode(quick, full), out, force, ovs, verbose, !no_preview))
+        Cmd::Run { target, quick, full, out, force, resume, set, verbose, no_preview } => {
+            if resumed(resume, out.as_deref()) {
+                Ok(())
+            } else {
+                overrides(&set).and_then(|ovs| {
+                    run_one(&target, mode(quick, full), out, force || resume, ovs, verbose, !no_preview)
+                })
+            }
         }
-        Cmd::Bench { krate, quick, full, out, force, sweep, set, verbose } => {
-            overrides(&set).and_then(|ovs| bench_one(&krate, mode(quick, full), out, force, sweep, ovs, verbose))
+        Cmd::Bench { krate, quick, full, out, force, sweep, point, resume, set, verbose } => {
+            if resumed(resume, out.as_deref()) {
+                Ok(())
+            } else {
+                overrides(&set).and_then(|ovs| {
+                    let b = BenchArgs { mode: mode(quick, full), out, force: force || resume, sweep, point };
+                    bench_one(&krate, b, ovs, verbose)
+                })
+            }
         }
+        Cmd::Plan { file, bench, sweep, quick, full, out, force } => {
+            plan(file.as_deref(), bench.as_deref(), sweep.as_deref(), mode(quick, full), &out, force)
+        }
+        Cmd::Sweep { cmd } => match cmd {
+            SweepCmd::Run { tasks, jobs } => sweep::local::run(&tasks, jobs),
+            SweepCmd::Slurm { tasks, partition, time, mem, throttle, no_submit } => {
+                let o = sweep::slurm::SlurmOpts { partition, time, mem, throttle };
+                sweep::slurm::submit(&tasks, &o, !no_submit)
+            }
+            SweepCmd::Collect { dir } => sweep::collect::collect(&dir).map(|_| ()),
+        },
         Cmd::Inspect { file } => inspect::inspect(&file),
         Cmd::Params { method } => params::print(method.as_deref()),
         Cmd::Rig { mesh, skeleton, up, front, units, out } => {
@@ -313,15 +420,65 @@ fn run_one(
     }
 }
 
-fn bench_one(
-    krate: &str,
+/// `--resume`: true (and says so) when `out` holds a finished run, which is then left as it is.
+fn resumed(resume: bool, out: Option<&std::path::Path>) -> bool {
+    match out {
+        Some(dir) if resume && sweep::task::state(dir) == sweep::task::TaskState::Finished => {
+            say!("finished already, skipped: {}", dir.display());
+            true
+        }
+        _ => false,
+    }
+}
+
+/// `plan`: a sweep file or a bench sweep into `out`.
+fn plan(
+    file: Option<&std::path::Path>,
+    bench: Option<&str>,
+    knob: Option<&str>,
+    mode: Mode,
+    out: &std::path::Path,
+    force: bool,
+) -> error::Result<()> {
+    let dir = paths::absolute(out);
+    let p = match (file, bench, knob) {
+        (Some(f), _, _) => sweep::plan::Plan::from_file(&sweep::file::load(f)?, &dir),
+        (None, Some(b), Some(k)) => sweep::plan::Plan::from_bench(b, k, mode, &dir)?,
+        _ => return Err(error::Error::Usage("plan needs a sweep file, or --bench <crate> --sweep <knob>".into())),
+    };
+    let lines = sweep::plan::write(&p, &dir, force)?;
+    let finished = p.tasks.iter().filter(|t| sweep::task::state(&t.dir) == sweep::task::TaskState::Finished).count();
+    say!(
+        "plan {}: {} tasks over {} ({} mode) → {}",
+        p.name(),
+        lines.len(),
+        p.parameters.join(" × "),
+        p.mode,
+        dir.display()
+    );
+    say!("  {}", dir.join(sweep::plan::TASKS_TXT).display());
+    say!("  {}", dir.join(sweep::plan::SWEEP_RON).display());
+    say!("  {}", dir.join(sweep::openjd::FILE).display());
+    if finished > 0 {
+        say!("  {finished} tasks already finished (kept)");
+    }
+    if let Some(first) = lines.first() {
+        say!("first task: {first}");
+    }
+    Ok(())
+}
+
+/// The arguments of `bench` besides the crate and overrides.
+struct BenchArgs {
     mode: Mode,
     out: Option<PathBuf>,
     force: bool,
     sweep: Option<String>,
-    overrides: Vec<Override>,
-    verbose: bool,
-) -> error::Result<()> {
+    point: Option<usize>,
+}
+
+fn bench_one(krate: &str, a: BenchArgs, overrides: Vec<Override>, verbose: bool) -> error::Result<()> {
+    let BenchArgs { mode, out, force, sweep, point } = a;
     let explicit = out.is_some();
     let dir = out.unwrap_or_else(|| out::default_out_root().join("bench").join(krate));
     let id = format!("bench/{krate}");
@@ -334,7 +491,7 @@ fn bench_one(
         previews: true,
         label: id.clone(),
     };
-    let r = run::run_bench(krate, sweep.as_deref(), &opts)?;
+    let r = run::run_bench(krate, sweep.as_deref(), point, &opts)?;
     run::print_closing(&id, mode, &dir, &r, verbose);
     Ok(())
 }

@@ -36,6 +36,14 @@ fn docs_of(krate: &str) -> Vec<Doc> {
         .collect()
 }
 
+/// Whether `name` is a field of any parameter struct of `krate` (from the doc comments collected
+/// at build time); `None` when no field of that crate was collected (old-style runners), so the
+/// question cannot be answered. Used to catch a misspelt field in a sweep before any task runs.
+pub fn is_field_of_crate(krate: &str, name: &str) -> Option<bool> {
+    let docs = docs_of(krate);
+    (!docs.is_empty()).then(|| docs.iter().any(|d| d.name == name))
+}
+
 /// Type names mentioned in a type text that are owners in `docs` (`Option<Wind>` → `Wind`).
 fn types_in(ty: &str, docs: &[Doc]) -> Vec<&'static str> {
     let mut v: Vec<&'static str> = Vec::new();

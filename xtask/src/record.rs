@@ -182,9 +182,27 @@ pub fn write_checks(dir: &Path, r: &Report) -> Result<()> {
     fs::write(&path, text + "\n").map_err(io_err(&path))
 }
 
+/// The file listing the figures of `summary.json` that measure time ([`Report::timing`]: wall
+/// times, rates, speed-ups, thread counts): what may differ between two runs of the same
+/// parameters; every other figure is bitwise reproducible. `sweep collect` and the comparisons
+/// of CI read it.
+pub const TIMING_JSON: &str = "timing.json";
+
+/// Writes `timing.json`: the keys the report marked as timing, plus the runner's own `wall_s`
+/// and `preview_s`.
+pub fn write_timing(dir: &Path, r: &Report) -> Result<()> {
+    let mut keys: Vec<&str> = r.timing.iter().map(String::as_str).collect();
+    keys.extend(["wall_s", "preview_s"]);
+    keys.sort_unstable();
+    keys.dedup();
+    let path = dir.join(TIMING_JSON);
+    let text = serde_json::to_string_pretty(&keys).map_err(|e| Error::Run(e.to_string()))?;
+    fs::write(&path, text + "\n").map_err(io_err(&path))
+}
+
 /// The one adapter between a scene file and a crate's experiment: loads the `params` block as
 /// `P`, runs `f` at the run's size with a [`FileRecorder`] in the run folder, draws the plots,
-/// writes `checks.json`, and returns the figures for `summary.json`.
+/// writes `checks.json` and `timing.json`, and returns the figures for `summary.json`.
 pub fn run_experiment<P, E>(
     ctx: &RunCtx,
     f: impl FnOnce(&P, Size, &mut dyn Recorder) -> std::result::Result<Report, E>,
@@ -200,6 +218,7 @@ where
     rec.finish()?;
     let report = report?;
     write_checks(&ctx.out_dir, &report)?;
+    write_timing(&ctx.out_dir, &report)?;
     Ok(Summary::from_report(&report))
 }
 

@@ -59,6 +59,9 @@ pub struct BenchCtx {
     /// `--sweep <knob>`: run only this sweep (one of the bench's [`Bench::sweeps`], or `all`);
     /// `None` runs the bench's default set.
     pub sweep: Option<String>,
+    /// `--point I` (with `--sweep <knob>`): run only the `I`-th point of that sweep
+    /// ([`crate::bench_points`]); `None` runs every point.
+    pub point: Option<usize>,
 }
 
 /// An accuracy-versus-time benchmark of one crate.

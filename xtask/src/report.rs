@@ -55,7 +55,7 @@ pub fn repro(mode: Mode, out_root: PathBuf) -> Result<()> {
         let id = format!("bench/{}", b.crate_name);
         let dir = out_root.join("bench").join(b.crate_name);
         let t = Instant::now();
-        let r = run_bench(b.crate_name, None, &opts(dir.clone(), bench_mode, format!("[{k}/{total}] {id}")));
+        let r = run_bench(b.crate_name, None, None, &opts(dir.clone(), bench_mode, format!("[{k}/{total}] {id}")));
         let o = Outcome { id, wall_s: t.elapsed().as_secs_f64(), error: r.err().map(|e| e.to_string()) };
         say!("{}", status_line(&o, bench_mode));
         outcomes.push(o);
@@ -275,6 +275,9 @@ pub fn write_markdown(report_dir: &Path, runs: &[RunInfo], wall_s: Option<f64>) 
         let checks = if r.checks.is_empty() { String::new() } else { format!("{pass}/{} pass", r.checks.len()) };
         let wall = r.wall_s().map(|w| format!("{w:.2}")).unwrap_or_default();
         let _ = writeln!(md, "| [{}](#{}) | {status} | {} | {wall} | {checks} |", r.id, anchor(&r.id), r.mode);
+    }
+    if let Some(root) = report_dir.parent() {
+        crate::sweep::report::markdown(&mut md, report_dir, root);
     }
     for r in runs {
         let _ = writeln!(md, "\n## {}\n\n{}\n\nMode `{}`.\n", r.id, r.description, r.mode);

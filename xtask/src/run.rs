@@ -267,7 +267,10 @@ pub fn run_scene_with(scene_id: &str, file: &Path, o: &RunOptions) -> Result<Run
 /// of the bench's sweeps (`--sweep <knob>`, or `all`); an unknown knob is a usage error naming the
 /// known ones. `--set` overrides apply to every scene file the bench reads; a bench that reads
 /// none refuses them.
-pub fn run_bench(crate_name: &str, sweep: Option<&str>, o: &RunOptions) -> Result<RunResult> {
+///
+/// `point` (`--point I`) runs only the `I`-th point of a splittable sweep
+/// ([`crate::bench_points::points`]); it needs `sweep` (not `all`).
+pub fn run_bench(crate_name: &str, sweep: Option<&str>, point: Option<usize>, o: &RunOptions) -> Result<RunResult> {
     let benches = registry::benches();
     let bench = benches.iter().find(|b| b.crate_name == crate_name).ok_or_else(|| {
         let known: Vec<&str> = benches.iter().map(|b| b.crate_name).collect();
@@ -284,6 +287,24 @@ pub fn run_bench(crate_name: &str, sweep: Option<&str>, o: &RunOptions) -> Resul
             )));
         }
     }
+    if let Some(i) = point {
+        let k = sweep.filter(|k| *k != "all").ok_or_else(|| {
+            Error::Usage(format!("--point {i} needs --sweep <knob> (one of: {})", bench.sweeps.join(", ")))
+        })?;
+        let n = crate::bench_points::points(crate_name, k, o.mode == Mode::Quick)
+            .ok_or_else(|| {
+                Error::Usage(format!(
+                    "the '{k}' sweep of the '{crate_name}' benchmark does not split into points; run it whole"
+                ))
+            })?
+            .len();
+        if i >= n {
+            return Err(Error::Usage(format!(
+                "--point {i}: the '{k}' sweep of '{crate_name}' has {n} points (0 … {})",
+                n - 1
+            )));
+        }
+    }
     prepare_dir(&o.out_dir, o.policy)?;
     scene::set_overrides(None, o.overrides.clone());
     let progress = RunProgress::start(&o.label);
@@ -293,6 +314,7 @@ pub fn run_bench(crate_name: &str, sweep: Option<&str>, o: &RunOptions) -> Resul
         full: o.mode == Mode::Full,
         out_dir: o.out_dir.to_path_buf(),
         sweep: sweep.map(str::to_string),
+        point,
     };
     let id = format!("bench/{crate_name}");
     let result = (|| {

@@ -235,7 +235,7 @@ pub fn read_scene_text(path: &Path) -> Result<(String, Vec<Override>)> {
 
 /// A ron error as a message a person can act on: the field it is about (path inside the file),
 /// integer/number expectations in words, and the override the bad value came from.
-fn spanned(path: &Path, text: &str, overrides: &[Override], e: ron::error::SpannedError) -> Error {
+pub fn spanned(path: &Path, text: &str, overrides: &[Override], e: ron::error::SpannedError) -> Error {
     let (line, col) = (e.span.start.line, e.span.start.col);
     let at = ronpath::offset_of(text, line, col);
     let o = ronpath::outline(text);
