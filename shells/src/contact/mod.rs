@@ -246,7 +246,14 @@ impl Ipc {
     /// The contact set at `x` (pairs closer than d̂), sorted by key, from the candidates of
     /// the last [`Ipc::sweep`] (whose segment must contain `x`).
     pub(crate) fn contacts(&self, x: &[Pt3]) -> Vec<Contact> {
-        let dhat = self.dhat;
+        self.contacts_within(x, self.dhat)
+    }
+
+    /// The pairs of the last sweep's candidates closer than `dist` at `x` (the contact set for
+    /// `dist` = d̂; a larger `dist` gives the pairs likely to become contacts soon, which
+    /// `ShellSim::grow_pattern` reserves in the sparsity pattern).
+    pub(crate) fn contacts_within(&self, x: &[Pt3], dist: f64) -> Vec<Contact> {
+        let dhat = dist;
         let topo = Topo { tris: &self.tris, edges: &self.edges, mean_edge: self.mean_edge, mu_self: self.mu_self };
         let Some(c) = self.cands.as_ref() else { return Vec::new() };
         let mut all = if self.self_collision { set::self_contacts(&topo, x, &c.vt, &c.ee, dhat) } else { Vec::new() };

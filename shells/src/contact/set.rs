@@ -90,6 +90,11 @@ impl Contact {
         })
     }
 
+    /// The cloth vertex of each stencil slot (`NONE` for obstacle points and unused slots).
+    pub fn cloth_nodes(&self) -> [u32; 4] {
+        self.nodes.map(|n| if let Node::Cloth(i) = n { i } else { NONE })
+    }
+
     /// The gap and its gradient at `x`.
     pub fn gap(&self, x: &[Pt3]) -> Gap {
         let p = self.points(x);
@@ -418,11 +423,13 @@ fn core_contacts(topo: &Topo, x: &[Pt3], o: u32, core: &Core, c: &CoreCands, mu:
     out
 }
 
-/// Sorts by key and keeps one contact per key.
-pub(crate) fn dedup(mut c: Vec<Contact>) -> Vec<Contact> {
-    c.sort_by_key(|a| a.key);
-    c.dedup_by(|a, b| a.key == b.key);
-    c
+/// Sorts by key and keeps one contact per key (the first of each key in input order: a stable
+/// sort of (key, index) pairs, so the large contacts themselves are moved once, not by the sort).
+pub(crate) fn dedup(c: Vec<Contact>) -> Vec<Contact> {
+    let mut order: Vec<((Feat, Feat), u32)> = c.iter().enumerate().map(|(i, a)| (a.key, i as u32)).collect();
+    order.sort_unstable();
+    order.dedup_by(|a, b| a.0 == b.0);
+    order.into_iter().map(|(_, i)| c[i as usize]).collect()
 }
 
 /// Vertex, edge and triangle boxes of the cloth at `x`, grown by `margin`, or swept to `x + dx`
