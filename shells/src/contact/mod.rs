@@ -155,11 +155,13 @@ impl Ipc {
         self.sweep(x0, None);
         let contacts = self.contacts(x0);
         let mut bad = 0u32;
+        let mut first_bad: Option<(&Contact, f64)> = None;
         let mut fr = Vec::new();
         for c in &contacts {
             let g = c.gap(x0);
             if !(g.d > 0.0) {
                 bad += 1;
+                first_bad.get_or_insert((c, g.d));
                 continue;
             }
             let lambda = self.kappa * -barrier::first(g.d, self.dhat);
@@ -182,9 +184,15 @@ impl Ipc {
             fr.extend(FrictionContact::new(c, x0, lambda, shift));
         }
         self.friction = fr;
-        if bad > 0 {
+        if let Some((c, d)) = first_bad {
             return Err(format!(
-                "{bad} contact pairs have no gap at the step's start: an obstacle moved into the cloth (shorten the step)"
+                "{bad} contact pair(s) have no gap at the step's start t = {t_prev} s; first: {} against {}, \
+                 gap {d:.3e} m (the log barrier needs every gap > 0: start the cloth at least the collision \
+                 thickness d̂ = {:.3e} m off obstacles and itself, or shorten the step if a moving obstacle \
+                 entered the cloth)",
+                c.key.0.describe(&self.edges),
+                c.key.1.describe(&self.edges),
+                self.dhat
             ));
         }
         Ok(self.friction.len() as u32)

@@ -35,6 +35,22 @@ pub(crate) enum Feat {
 }
 
 impl Feat {
+    /// A user-facing name of the feature (cloth ids are vertex indices of the scene's mesh).
+    pub(crate) fn describe(self, edges: &[[u32; 2]]) -> String {
+        match self {
+            Feat::V(i) => format!("cloth vertex {i}"),
+            Feat::E(i) => {
+                let e = edges.get(i as usize).copied().unwrap_or([NONE, NONE]);
+                format!("cloth edge {}–{}", e[0], e[1])
+            }
+            Feat::T(i) => format!("cloth triangle {i}"),
+            Feat::OP(o, i) => format!("obstacle {o} (its point {i})"),
+            Feat::OE(o, i) => format!("obstacle {o} (its edge {i})"),
+            Feat::OT(o, i) => format!("obstacle {o} (its triangle {i})"),
+            Feat::Half(o) => format!("obstacle {o} (plane)"),
+        }
+    }
+
     /// A u64 with the same order as the derived `Ord` (variant in declaration order, then the
     /// fields), for sorting contact keys as integers.
     fn code(self) -> u64 {
