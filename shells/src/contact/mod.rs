@@ -12,12 +12,14 @@
 //! [`crate::effects::ContactMethod::Bridson`]), whose rigid impact zones and obstacle pass
 //! added energy and let vertices through obstacles (README, "Contact").
 //!
-//! The contact Hessian is the Gauss–Newton form κ b″(d) ∇d∇dᵀ (PSD, b is convex). Its blocks
-//! enter the system's fixed sparsity pattern where one exists (vertices sharing a triangle, and
-//! every obstacle contact, whose cloth vertices share a triangle or an edge); a block coupling two
-//! vertices the pattern does not hold is replaced by ‖B‖_F·I on both diagonals, which keeps the
-//! matrix an upper bound of the exact one (PSD), so every Newton direction is still a descent
-//! direction and the symbolic factorisation (and `tracks`' constrained solvers) never change.
+//! The contact Hessian is the Gauss–Newton form κ b″(d) ∇d∇dᵀ (PSD, b is convex); friction's
+//! is the majorizer μλ f₁(y)/y on the tangent plane ([`friction`]). With the simulator's own
+//! solve the blocks enter the matrix exactly: contact pairs coupling vertices that share no
+//! triangle grow the sparsity pattern (`ShellSim::grow_pattern`, re-analysing the Cholesky only
+//! when it grows; a handful of new pairs stays lumped as below until more are missing). With a delegated solve (`tracks`, whose constrained factorisations are built
+//! on the mesh's fixed pattern) such a block is replaced by ‖B‖-scaled blocks on both diagonals
+//! ([`Ipc::add`]), which keeps the matrix an upper bound of the exact one (PSD), so every Newton
+//! direction is still a descent direction.
 
 pub mod accd;
 pub mod barrier;
