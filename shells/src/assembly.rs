@@ -512,7 +512,7 @@ mod tests {
         asm.assemble(&mesh, &inp, &mut force);
         let y1 = product(&asm, &u);
         let fi = &asm.dofs.free_index;
-        let mut yc = vec![0.0; 18];
+        let mut yc = [0.0; 18];
         for (i, j, m) in [(0u32, 4u32, b), (1, 2, c)] {
             let (fi_, fj_) = (fi[i as usize] as usize, fi[j as usize] as usize);
             let (ui, uj) =
