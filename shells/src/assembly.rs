@@ -23,6 +23,10 @@ use rayon::prelude::*;
 const TRI_VALS: usize = 81;
 const HINGE_VALS: usize = 144;
 const DIAG_VALS: usize = 9;
+/// Values per extra (contact-coupling) pair: blocks (i, j) and (j, i) stacked as the rows of a
+/// 6 × 3 column-major matrix with column stride 9, the stride of the triangles' local matrices,
+/// so every off-diagonal block offset is addressed alike (`vals[off + 9c + r]`).
+const EXTRA_VALS: usize = 27;
 
 /// Inputs of one element pass.
 pub(crate) struct EvalInput<'a> {
@@ -75,17 +79,52 @@ pub(crate) struct Assembler {
     pub contact_diag: Vec<Mat3>,
     /// Contact off-diagonal blocks inside the pattern: (offset in a triangle's local matrix, block).
     pub contact_offdiag: Vec<(usize, Mat3)>,
-    /// Offset of block (i, j) in the local matrix of the first triangle holding both vertices.
+    /// Offset in the element buffers of block (i, j): in the local matrix of the first triangle
+    /// holding both vertices, or in the contact-coupling region for an [`Assembler::extra`] pair.
     pub(crate) block_offset: std::collections::HashMap<(u32, u32), usize>,
+    /// Vertex pairs (i < j, both free, sharing no triangle) whose 3×3 coupling blocks the pattern
+    /// also holds (contact pairs of IPC, [`Assembler::with_extra`]); sorted.
+    pub(crate) extra: Vec<(u32, u32)>,
+    off_extra: usize,
 }
 
 impl Assembler {
     pub(crate) fn new(mesh: &ShellMesh, dofs: DofMap) -> Self {
+        Self::with_extra(mesh, dofs, Vec::new())
+    }
+
+    /// The assembler of the mesh's pattern plus the coupling blocks of the vertex pairs `extra`
+    /// (pairs already in the mesh's pattern, with a constrained vertex, or i = j are dropped).
+    /// Each extra pair owns [`EXTRA_VALS`] values after the diagonal blocks (blocks (i, j) and
+    /// (j, i)); only their lower-triangle entries enter the matrix (as for elements).
+    pub(crate) fn with_extra(mesh: &ShellMesh, dofs: DofMap, mut extra: Vec<(u32, u32)>) -> Self {
         let nt = mesh.tris.len();
         let nh = mesh.hinges.len();
         let nf = dofs.n_free();
         let off_hinge = nt * TRI_VALS;
         let off_diag = off_hinge + nh * HINGE_VALS;
+        let off_extra = off_diag + nf * DIAG_VALS;
+        let mut block_offset = std::collections::HashMap::new();
+        for (t, tri) in mesh.tris.iter().enumerate() {
+            for a in 0..3 {
+                for b in 0..3 {
+                    if a != b {
+                        block_offset.entry((tri[a], tri[b])).or_insert(t * TRI_VALS + 3 * b * 9 + 3 * a);
+                    }
+                }
+            }
+        }
+        for p in extra.iter_mut() {
+            *p = (p.0.min(p.1), p.0.max(p.1));
+        }
+        extra.sort_unstable();
+        extra.dedup();
+        extra.retain(|&(i, j)| {
+            i != j
+                && dofs.free_index[i as usize] != NONE
+                && dofs.free_index[j as usize] != NONE
+                && !block_offset.contains_key(&(i, j))
+        });
         let mut keys: Vec<(u32, u32)> = Vec::new();
         let mut src: Vec<u32> = Vec::new();
         let fi = &dofs.free_index;
@@ -127,6 +166,23 @@ impl Assembler {
                 }
             }
         }
+        for (k, &(i, j)) in extra.iter().enumerate() {
+            let base = off_extra + EXTRA_VALS * k;
+            for (blk, (a, b)) in [(i, j), (j, i)].into_iter().enumerate() {
+                let (fa, fb) = (fi[a as usize], fi[b as usize]);
+                if fa < fb {
+                    continue; // strictly upper block: its transpose carries the entries
+                }
+                for r in 0..3u32 {
+                    for c in 0..3u32 {
+                        keys.push((3 * fa + r, 3 * fb + c));
+                        src.push((base + 3 * blk + (9 * c + r) as usize) as u32);
+                    }
+                }
+            }
+            block_offset.insert((i, j), base);
+            block_offset.insert((j, i), base + 3);
+        }
         let pattern = FixedPattern::new(3 * nf, 3 * nf, &keys, true);
         // Per stored entry, the `vals` indices of its contributions in increasing key order (the
         // order FixedPattern sums in).
@@ -149,16 +205,6 @@ impl Assembler {
             }
         }
         let mat = pattern.csc().clone();
-        let mut block_offset = std::collections::HashMap::new();
-        for (t, tri) in mesh.tris.iter().enumerate() {
-            for a in 0..3 {
-                for b in 0..3 {
-                    if a != b {
-                        block_offset.entry((tri[a], tri[b])).or_insert(t * TRI_VALS + 3 * b * 9 + 3 * a);
-                    }
-                }
-            }
-        }
         // Per-vertex force gather in element order (triangles first, then hinges).
         let n = mesh.n_vertices();
         let mut count = vec![0u32; n + 1];
@@ -194,7 +240,7 @@ impl Assembler {
             mat,
             gather_ptr,
             gather,
-            vals: vec![0.0; off_diag + nf * DIAG_VALS],
+            vals: vec![0.0; off_extra + EXTRA_VALS * extra.len()],
             off_hinge,
             off_diag,
             elem_force: vec![Vec3::zeros(); 3 * nt + 4 * nh],
@@ -209,11 +255,18 @@ impl Assembler {
             contact_diag: vec![Mat3::zeros(); nf],
             contact_offdiag: Vec::new(),
             block_offset,
+            extra,
+            off_extra,
             dofs,
         }
     }
 
-    /// Offset of the (i, j) block (i ≠ j sharing a triangle) in the triangle buffers.
+    /// Where the contact-coupling blocks of the extra pairs start in the element buffers.
+    pub(crate) fn off_extra(&self) -> usize {
+        self.off_extra
+    }
+
+    /// Offset of the (i, j) block (i ≠ j sharing a triangle, or an extra pair) in the buffers.
     pub(crate) fn block_offset(&self, i: u32, j: u32) -> Option<usize> {
         self.block_offset.get(&(i, j)).copied()
     }
@@ -342,23 +395,25 @@ impl Assembler {
                 }
                 m.copy_from_slice(mat.as_slice());
             });
-        // Custom off-diagonal Jacobian blocks, in the order given (deterministic).
-        for &(off, m) in self.custom_offdiag.iter().chain(&self.contact_offdiag) {
-            for r in 0..3 {
-                for c in 0..3 {
-                    tri_vals[off + c * 9 + r] += m[(r, c)];
-                }
-            }
-        }
         // Diagonal mass blocks (1 + hα + τ)m I + custom Jacobian blocks.
         let dofs = &self.dofs;
         let (custom, contact) = (&self.custom_diag, &self.contact_diag);
-        diag_vals.par_chunks_mut(DIAG_VALS).enumerate().for_each(|(fidx, d)| {
+        diag_vals[..dofs.n_free() * DIAG_VALS].par_chunks_mut(DIAG_VALS).enumerate().for_each(|(fidx, d)| {
             let v = dofs.free_vertices[fidx] as usize;
             let m = mesh.mass[v] * (1.0 + h * alpha + inp.shift);
             let blk = Mat3::from_diagonal_element(m) + custom[fidx] + contact[fidx];
             d.copy_from_slice(blk.as_slice());
         });
+        // Custom and contact off-diagonal blocks, in the order given (deterministic), onto the
+        // element buffers and the (zeroed) contact-coupling region.
+        self.vals[self.off_extra..].fill(0.0);
+        for &(off, m) in self.custom_offdiag.iter().chain(&self.contact_offdiag) {
+            for r in 0..3 {
+                for c in 0..3 {
+                    self.vals[off + c * 9 + r] += m[(r, c)];
+                }
+            }
+        }
         // Per-vertex force sums in fixed element order.
         let (ptr, idx, ef) = (&self.force_ptr, &self.force_idx, &self.elem_force);
         force.par_iter_mut().enumerate().for_each(|(v, out)| {
@@ -386,5 +441,94 @@ impl Assembler {
             self.vals[o..o + DIAG_VALS].copy_from_slice(blk.as_slice());
         }
         self.gather_matrix();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::Material;
+
+    /// Two triangles and a far vertex pair (0, 4) that shares no triangle; vertex 5 is pinned.
+    fn setup(extra: Vec<(u32, u32)>) -> (ShellMesh, Assembler) {
+        let p = vec![
+            Pt3::new(0.0, 0.0, 0.0),
+            Pt3::new(1.0, 0.0, 0.0),
+            Pt3::new(1.0, 1.0, 0.1),
+            Pt3::new(0.0, 1.0, 0.0),
+            Pt3::new(3.0, 0.0, 0.0),
+            Pt3::new(3.0, 1.0, 0.0),
+            Pt3::new(4.0, 0.5, 0.0),
+        ];
+        let f = [[0, 1, 2], [0, 2, 3], [4, 6, 5]];
+        let mesh = ShellMesh::new(p, &f, None, &Material::cotton()).unwrap();
+        let mut dofs = DofMap { free_index: vec![NONE; 7], ..Default::default() };
+        for i in [0u32, 1, 2, 3, 4, 6] {
+            dofs.free_index[i as usize] = dofs.free_vertices.len() as u32;
+            dofs.free_vertices.push(i);
+        }
+        dofs.pinned.push(5);
+        let asm = Assembler::with_extra(&mesh, dofs, extra);
+        (mesh, asm)
+    }
+
+    fn product(asm: &Assembler, u: &[f64]) -> Vec<f64> {
+        let mut y = vec![0.0; u.len()];
+        geom_core::linalg::sym_mul_vec(asm.matrix(), u, &mut y);
+        y
+    }
+
+    /// Contact-coupling blocks of extra pairs land in the matrix exactly where they belong:
+    /// A·u = A₀·u + C·u, with C the blocks handed in (both orientations), for a pair in the
+    /// mesh pattern and for an extra pair; pairs with a pinned vertex or already in the
+    /// pattern are not added as extra.
+    #[test]
+    fn extra_pairs_hold_their_coupling_blocks() {
+        let (mesh, mut asm) = setup(vec![(4, 0), (2, 0), (0, 5), (2, 2), (1, 3)]);
+        assert_eq!(asm.extra, vec![(0, 4), (1, 3)], "(0, 2) shares a triangle, 5 is pinned, (2, 2) is a diagonal");
+        let law = Membrane::isotropic(2000.0, 0.3);
+        let q = mesh.rest.iter().map(|p| p + Vec3::new(0.01 * p.y, -0.02 * p.x, 0.03)).collect::<Vec<_>>();
+        let v = vec![Vec3::zeros(); 7];
+        let inp = EvalInput {
+            q: &q,
+            v: &v,
+            h_eff: 0.01,
+            mode: HessianMode::ProjectedCheap,
+            law: &law,
+            damping: (0.0, 0.0, 0.0, 0.0),
+            wind: None,
+            shift: 0.0,
+        };
+        let mut force = vec![Vec3::zeros(); 7];
+        asm.assemble(&mesh, &inp, &mut force);
+        let u: Vec<f64> = (0..18).map(|k| ((k * 7919) % 13) as f64 - 6.0).collect();
+        let y0 = product(&asm, &u);
+        let b = Mat3::new(1.0, 2.0, 3.0, -4.0, 5.0, 6.0, 7.0, -8.0, 9.5);
+        let c = Mat3::new(0.5, -1.0, 0.25, 2.0, 1.5, -3.0, 0.0, 4.0, 1.0);
+        for (i, j, m) in [(0u32, 4u32, b), (1, 2, c)] {
+            asm.contact_offdiag.push((asm.block_offset(i, j).unwrap(), m));
+            asm.contact_offdiag.push((asm.block_offset(j, i).unwrap(), m.transpose()));
+        }
+        asm.assemble(&mesh, &inp, &mut force);
+        let y1 = product(&asm, &u);
+        let fi = &asm.dofs.free_index;
+        let mut yc = [0.0; 18];
+        for (i, j, m) in [(0u32, 4u32, b), (1, 2, c)] {
+            let (fi_, fj_) = (fi[i as usize] as usize, fi[j as usize] as usize);
+            let (ui, uj) =
+                (Vec3::from_column_slice(&u[3 * fi_..3 * fi_ + 3]), Vec3::from_column_slice(&u[3 * fj_..3 * fj_ + 3]));
+            let (ri, rj) = (m * uj, m.transpose() * ui);
+            for k in 0..3 {
+                yc[3 * fi_ + k] += ri[k];
+                yc[3 * fj_ + k] += rj[k];
+            }
+        }
+        for k in 0..18 {
+            assert!((y1[k] - y0[k] - yc[k]).abs() < 1e-12, "row {k}: {} vs {}", y1[k] - y0[k], yc[k]);
+        }
+        // The region is cleared by every assembly: without the blocks, A₀ again.
+        asm.contact_offdiag.clear();
+        asm.assemble(&mesh, &inp, &mut force);
+        assert_eq!(product(&asm, &u), y0);
     }
 }

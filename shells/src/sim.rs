@@ -355,7 +355,8 @@ impl ShellSim {
         self.llt.symbolic()
     }
 
-    /// How many symbolic analyses were computed (1: the pattern never changes).
+    /// How many symbolic analyses were computed (1 when the pattern never changes; IPC contact
+    /// adds one whenever its pairs grow the pattern, `ShellSim::grow_pattern`).
     pub fn symbolic_analyses(&self) -> u32 {
         self.symbolic_analyses
     }
@@ -669,6 +670,11 @@ impl ShellSim {
         let qk = self.state.q.clone();
         let tc = Instant::now();
         let fr = ipc.begin_step(&qk, t_next, h).map_err(|reason| Error::Diverged { step: self.steps, reason })?;
+        if solver.is_some() && !self.asm.extra.is_empty() {
+            // A delegated solve (tracks) works on the mesh's fixed pattern and its symbolic
+            // analysis: drop the contact couplings (their blocks are lumped, `Ipc::add`).
+            self.set_pattern(Vec::new())?;
+        }
         st.contact.friction = fr;
         // Collision-free start: (A) prescribed vertices toward their targets, (B) the free
         // vertices' predictor q_base + h_eff v_k, each clamped by CCD from a feasible state.
@@ -712,6 +718,7 @@ impl ShellSim {
         let nf = self.asm.dofs.n_free();
         let mut force = vec![Vec3::zeros(); n];
         let mut converged = false;
+        let dec_tol = 0.5 * ipc.newton_tol.powi(2) * free.iter().map(|&i| self.mesh.mass[i as usize]).sum::<f64>();
         // Φ of the current iterate, carried over from the accepted trial of the last iteration.
         let mut phi_cur: Option<f64> = None;
         for _ in 0..ipc.max_iters {
@@ -719,10 +726,14 @@ impl ShellSim {
             for i in 0..n {
                 x[i] = q_base[i] + h_eff * v_cur[i];
             }
-            self.custom_jacobians(t_next, &x, v_cur, h_eff)?;
             // Contact blocks first: the element pass below gathers them into the matrix.
             let tcc = Instant::now();
             let contacts = ipc.contacts(&x);
+            if solver.is_none() {
+                self.grow_pattern(ipc, &x, &contacts, st)?;
+            }
+            self.custom_jacobians(t_next, &x, v_cur, h_eff)?;
+
             let mut cforce = vec![Vec3::zeros(); n];
             self.asm.contact_diag.iter_mut().for_each(|d| *d = Mat3::zeros());
             self.asm.contact_offdiag.clear();
@@ -742,6 +753,7 @@ impl ShellSim {
                         if fi == NONE || fj == NONE {
                             return;
                         }
+
                         if i == j {
                             diag[fi as usize] += m;
                         } else if let Some(&off) = offsets.get(&(i, j)) {
@@ -807,6 +819,16 @@ impl ShellSim {
             st.lin_residual = rel_residual(self.asm.matrix(), &dv, &b);
             st.newton_iters += 1;
             let dv_max = dv.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            // Converged when the Newton direction is below the velocity tolerance everywhere
+            // (‖Δv‖∞ = ‖Δx‖∞/h_eff ≤ newton_tol), or — for the simulator's own solve, where
+            // A Δv = b holds — when the Newton decrement ½ΔvᵀAΔv = ½Δvᵀb (the model's predicted
+            // decrease of Φ, the standard stopping test of Newton's method, Boyd & Vandenberghe
+            // §9.5) is below ½ Σ m_i newton_tol², the kinetic energy of the whole cloth moving
+            // at the tolerance: the ∞-norm alone is held hostage by a single vertex drifting
+            // along a nearly flat mode (a buckle of the twisted tube: 1–2 vertices, ‖Δv‖ ~ 0.1
+            // m/s for 10+ iterations while Φ changes by 1e-6 J).
+            let decrement = 0.5 * dv.iter().zip(&b).map(|(x, y)| x * y).sum::<f64>();
+            let small = dv_max <= ipc.newton_tol || (solver.is_none() && decrement <= dec_tol);
             // CCD bound, then backtracking on Φ (barrier and friction included).
             let tl = Instant::now();
             let mut step_dx = vec![Vec3::zeros(); n];
@@ -824,7 +846,7 @@ impl ShellSim {
                 st.t_collision += tl.elapsed().as_secs_f64();
                 break;
             }
-            if dv_max <= ipc.newton_tol {
+            if small {
                 // Converged: take the (CCD-safe) step without a line search.
                 for (fidx, &vtx) in free.iter().enumerate() {
                     let i = vtx as usize;
@@ -912,14 +934,22 @@ impl ShellSim {
                 }
             }
             if std::env::var_os("SHELLS_IPC_DEBUG").is_some() {
+                let (kmax, _) =
+                    dv.iter().enumerate().fold((0, 0.0f64), |m, (k, x)| if x.abs() > m.1 { (k, x.abs()) } else { m });
+                let vmax = free[kmax / 3];
+                let nc = contacts.iter().filter(|c| c.cloth_nodes().contains(&vmax)).count();
+                let d3 = Vec3::new(dv[kmax / 3 * 3], dv[kmax / 3 * 3 + 1], dv[kmax / 3 * 3 + 2]);
+                let n_big = dv.chunks(3).filter(|c| c.iter().any(|x| x.abs() > 0.5 * dv_max)).count();
                 eprintln!(
-                    "  iter {}: |dv| {dv_max:.3e} alpha {a:.3e} contacts {} phi0 {phi0:.6e}",
+                    "  iter {}: |dv| {dv_max:.3e} alpha {a:.3e} contacts {} phi0 {phi0:.6e} phi {phi:.6e} | vmax {vmax} y {:.4} dv {:?} in {nc} contacts, {n_big} verts > half",
                     st.newton_iters,
-                    contacts.len()
+                    contacts.len(),
+                    x[vmax as usize].y,
+                    d3.as_slice(),
                 );
             }
             st.t_collision += tl.elapsed().as_secs_f64();
-            if dv_max <= ipc.newton_tol {
+            if small {
                 converged = true;
                 break;
             }
@@ -936,6 +966,74 @@ impl ShellSim {
         st.contact.min_gap = end.iter().map(|c| c.gap(&x).d).fold(f64::INFINITY, f64::min);
         ipc.adapt_kappa(st.contact.min_gap);
         st.contact.kappa = ipc.kappa;
+        Ok(())
+    }
+
+    /// Adds to the system's pattern the coupling blocks of the contact pairs it lacks (two free
+    /// cloth vertices of one contact stencil that share no triangle), so that the contact
+    /// Hessian enters the matrix exactly instead of being lumped onto the diagonals: with
+    /// lumped couplings two layers in contact see each other as fixed walls and Newton
+    /// converges linearly on piled cloth. The pattern only grows (a superset kept across steps,
+    /// so a pile's pairs cost few analyses, not one per iteration): a growth reserves the pairs
+    /// of every candidate closer than 2d̂, and a handful of missing pairs (fewer than 1/16 of
+    /// the kept ones) stays lumped until more are missing. The superset is rebuilt from the
+    /// current pairs when it is more than four times what the contacts use.
+    fn grow_pattern(
+        &mut self,
+        ipc: &Ipc,
+        x: &[Pt3],
+        contacts: &[crate::contact::set::Contact],
+        st: &mut StepStats,
+    ) -> Result<()> {
+        let (need, used) = self.missing_pairs(contacts);
+        if need.is_empty() || (16 * need.len() < self.asm.extra.len() && need.len() < 256) {
+            return Ok(());
+        }
+        let te = Instant::now();
+        let near = ipc.contacts_within(x, 2.0 * ipc.dhat);
+        let (more, _) = self.missing_pairs(&near);
+        let mut extra =
+            if self.asm.extra.len() > 4 * (used + more.len()) { Vec::new() } else { self.asm.extra.clone() };
+        extra.extend(need);
+        extra.extend(more);
+        self.set_pattern(extra)?;
+        st.t_factor += te.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The free cloth-vertex pairs of the contacts' stencils that the pattern lacks, and how
+    /// many stencil pairs use the pattern's contact-coupling blocks.
+    fn missing_pairs(&self, contacts: &[crate::contact::set::Contact]) -> (Vec<(u32, u32)>, usize) {
+        let fi = &self.asm.dofs.free_index;
+        let mut need: Vec<(u32, u32)> = Vec::new();
+        let mut used = 0usize;
+        for c in contacts {
+            let ids = c.cloth_nodes();
+            for a in 0..4 {
+                for b in a + 1..4 {
+                    let (i, j) = (ids[a], ids[b]);
+                    if i == NONE || j == NONE || i == j || fi[i as usize] == NONE || fi[j as usize] == NONE {
+                        continue;
+                    }
+                    match self.asm.block_offset.get(&(i, j)) {
+                        Some(&off) if off >= self.asm.off_extra() => used += 1,
+                        Some(_) => {}
+                        None => need.push((i.min(j), i.max(j))),
+                    }
+                }
+            }
+        }
+        need.sort_unstable();
+        need.dedup();
+        (need, used)
+    }
+
+    /// Rebuilds the assembler with the mesh's pattern plus the coupling blocks of `extra` and
+    /// re-analyses the Cholesky factorisation (counted in [`ShellSim::symbolic_analyses`]).
+    fn set_pattern(&mut self, extra: Vec<(u32, u32)>) -> Result<()> {
+        self.asm = Assembler::with_extra(&self.mesh, self.asm.dofs.clone(), extra);
+        self.llt = SparseLlt::analyze(self.asm.matrix(), Ordering::Amd)?;
+        self.symbolic_analyses += 1;
         Ok(())
     }
 

@@ -65,3 +65,25 @@ fn filters_through_the_collision_pass() {
     assert!(ymin > 0.0, "went through the plane: {ymin}");
     assert!(sim.state().v.iter().all(|v| v.y > -3.0), "velocities were filtered");
 }
+
+/// A start state with a zero gap (a sheet lying exactly on the floor) is refused with an error
+/// that names the first offending pair and its gap, before any state change (README, "Contact
+/// (issue 20)": no silent push-out).
+#[test]
+fn a_zero_gap_start_names_the_pair() {
+    let (p, f) = sheet(4, 0.3, 0.0);
+    let mut d = desc(p.clone(), f, cloth(Damping::None));
+    d.effects.collision = Some(CollisionSettings { thickness: 0.004, ..Default::default() });
+    d.effects.obstacles =
+        vec![Obstacle { shape: ObstacleShape::Plane { normal: Vec3::y(), offset: 0.0 }, friction: 0.5, motion: None }];
+    let mut sim = ShellSim::new(d).unwrap();
+    match sim.step(1.0 / 60.0) {
+        Err(ShellError::Diverged { reason, .. }) => {
+            assert!(reason.contains("16 contact pair(s) have no gap"), "{reason}");
+            assert!(reason.contains("cloth vertex 0 against obstacle 0 (plane), gap 0.000e0 m"), "{reason}");
+        }
+        other => panic!("expected a zero-gap error, got {other:?}"),
+    }
+    assert_eq!(sim.state().q, p, "the state is unchanged");
+    assert_eq!(sim.state().t, 0.0);
+}

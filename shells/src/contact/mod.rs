@@ -12,12 +12,14 @@
 //! [`crate::effects::ContactMethod::Bridson`]), whose rigid impact zones and obstacle pass
 //! added energy and let vertices through obstacles (README, "Contact").
 //!
-//! The contact Hessian is the Gauss–Newton form κ b″(d) ∇d∇dᵀ (PSD, b is convex). Its blocks
-//! enter the system's fixed sparsity pattern where one exists (vertices sharing a triangle, and
-//! every obstacle contact, whose cloth vertices share a triangle or an edge); a block coupling two
-//! vertices the pattern does not hold is replaced by ‖B‖_F·I on both diagonals, which keeps the
-//! matrix an upper bound of the exact one (PSD), so every Newton direction is still a descent
-//! direction and the symbolic factorisation (and `tracks`' constrained solvers) never change.
+//! The contact Hessian is the Gauss–Newton form κ b″(d) ∇d∇dᵀ (PSD, b is convex); friction's
+//! is the majorizer μλ f₁(y)/y on the tangent plane ([`friction`]). With the simulator's own
+//! solve the blocks enter the matrix exactly: contact pairs coupling vertices that share no
+//! triangle grow the sparsity pattern (`ShellSim::grow_pattern`, re-analysing the Cholesky only
+//! when it grows; a handful of new pairs stays lumped as below until more are missing). With a delegated solve (`tracks`, whose constrained factorisations are built
+//! on the mesh's fixed pattern) such a block is replaced by ‖B‖-scaled blocks on both diagonals
+//! ([`Ipc::add`]), which keeps the matrix an upper bound of the exact one (PSD), so every Newton
+//! direction is still a descent direction.
 
 pub mod accd;
 pub mod barrier;
@@ -166,11 +168,13 @@ impl Ipc {
         self.sweep(x0, None);
         let contacts = self.contacts(x0);
         let mut bad = 0u32;
+        let mut first_bad: Option<(&Contact, f64)> = None;
         let mut fr = Vec::new();
         for c in &contacts {
             let g = c.gap(x0);
             if !(g.d > 0.0) {
                 bad += 1;
+                first_bad.get_or_insert((c, g.d));
                 continue;
             }
             let lambda = self.kappa * -barrier::first(g.d, self.dhat);
@@ -193,9 +197,15 @@ impl Ipc {
             fr.extend(FrictionContact::new(c, x0, lambda, shift));
         }
         self.friction = fr;
-        if bad > 0 {
+        if let Some((c, d)) = first_bad {
             return Err(format!(
-                "{bad} contact pairs have no gap at the step's start: an obstacle moved into the cloth (shorten the step)"
+                "{bad} contact pair(s) have no gap at the step's start t = {t_prev} s; first: {} against {}, \
+                 gap {d:.3e} m (the log barrier needs every gap > 0: start the cloth at least the collision \
+                 thickness d̂ = {:.3e} m off obstacles and itself, or shorten the step if a moving obstacle \
+                 entered the cloth)",
+                c.key.0.describe(&self.edges),
+                c.key.1.describe(&self.edges),
+                self.dhat
             ));
         }
         Ok(self.friction.len() as u32)
@@ -257,7 +267,14 @@ impl Ipc {
     /// The contact set at `x` (pairs closer than d̂), sorted by key, from the candidates of
     /// the last [`Ipc::sweep`] (whose segment must contain `x`).
     pub(crate) fn contacts(&self, x: &[Pt3]) -> Vec<Contact> {
-        let dhat = self.dhat;
+        self.contacts_within(x, self.dhat)
+    }
+
+    /// The pairs of the last sweep's candidates closer than `dist` at `x` (the contact set for
+    /// `dist` = d̂; a larger `dist` gives the pairs likely to become contacts soon, which
+    /// `ShellSim::grow_pattern` reserves in the sparsity pattern).
+    pub(crate) fn contacts_within(&self, x: &[Pt3], dist: f64) -> Vec<Contact> {
+        let dhat = dist;
         let topo = Topo { tris: &self.tris, edges: &self.edges, mean_edge: self.mean_edge, mu_self: self.mu_self };
         let Some(c) = self.cands.as_ref() else { return Vec::new() };
         let mut all = if self.self_collision { set::self_contacts(&topo, x, &c.vt, &c.ee, dhat) } else { Vec::new() };

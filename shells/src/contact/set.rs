@@ -34,6 +34,40 @@ pub(crate) enum Feat {
     Half(u32),
 }
 
+impl Feat {
+    /// A user-facing name of the feature (cloth ids are vertex indices of the scene's mesh).
+    pub(crate) fn describe(self, edges: &[[u32; 2]]) -> String {
+        match self {
+            Feat::V(i) => format!("cloth vertex {i}"),
+            Feat::E(i) => {
+                let e = edges.get(i as usize).copied().unwrap_or([NONE, NONE]);
+                format!("cloth edge {}–{}", e[0], e[1])
+            }
+            Feat::T(i) => format!("cloth triangle {i}"),
+            Feat::OP(o, i) => format!("obstacle {o} (its point {i})"),
+            Feat::OE(o, i) => format!("obstacle {o} (its edge {i})"),
+            Feat::OT(o, i) => format!("obstacle {o} (its triangle {i})"),
+            Feat::Half(o) => format!("obstacle {o} (plane)"),
+        }
+    }
+
+    /// A u64 with the same order as the derived `Ord` (variant in declaration order, then the
+    /// fields), for sorting contact keys as integers.
+    fn code(self) -> u64 {
+        let (tag, a, b) = match self {
+            Feat::V(i) => (0u64, 0, i),
+            Feat::E(i) => (1, 0, i),
+            Feat::T(i) => (2, 0, i),
+            Feat::OP(o, i) => (3, o, i),
+            Feat::OE(o, i) => (4, o, i),
+            Feat::OT(o, i) => (5, o, i),
+            Feat::Half(o) => (6, o, 0),
+        };
+        debug_assert!(a < 1 << 29, "obstacle index {a} beyond the key's 29 bits");
+        tag << 61 | (a as u64) << 32 | b as u64
+    }
+}
+
 /// A point of a contact stencil: a cloth vertex (a degree of freedom) or a fixed obstacle point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) enum Node {
@@ -88,6 +122,11 @@ impl Contact {
             Node::Fixed(p) => p,
             Node::Unused => Pt3::origin(),
         })
+    }
+
+    /// The cloth vertex of each stencil slot (`NONE` for obstacle points and unused slots).
+    pub fn cloth_nodes(&self) -> [u32; 4] {
+        self.nodes.map(|n| if let Node::Cloth(i) = n { i } else { NONE })
     }
 
     /// The gap and its gradient at `x`.
@@ -418,11 +457,17 @@ fn core_contacts(topo: &Topo, x: &[Pt3], o: u32, core: &Core, c: &CoreCands, mu:
     out
 }
 
-/// Sorts by key and keeps one contact per key.
-pub(crate) fn dedup(mut c: Vec<Contact>) -> Vec<Contact> {
-    c.sort_by_key(|a| a.key);
-    c.dedup_by(|a, b| a.key == b.key);
-    c
+/// Sorts by key and keeps one contact per key (the first of each key in input order: a stable
+/// sort of (key, index) pairs, so the large contacts themselves are moved once, not by the sort).
+pub(crate) fn dedup(c: Vec<Contact>) -> Vec<Contact> {
+    let mut order: Vec<(u128, u32)> = c
+        .iter()
+        .enumerate()
+        .map(|(i, a)| ((a.key.0.code() as u128) << 64 | a.key.1.code() as u128, i as u32))
+        .collect();
+    order.sort_unstable();
+    order.dedup_by(|a, b| a.0 == b.0);
+    order.into_iter().map(|(_, i)| c[i as usize]).collect()
 }
 
 /// Vertex, edge and triangle boxes of the cloth at `x`, grown by `margin`, or swept to `x + dx`
@@ -493,6 +538,27 @@ mod tests {
             }
             // The fixed slot has no degree of freedom, but its gradient entry is still the
             // distance's (used by nobody): only cloth slots are assembled.
+        }
+    }
+
+    #[test]
+    fn feature_codes_keep_the_key_order() {
+        let f = [
+            Feat::V(3),
+            Feat::V(70_000),
+            Feat::E(0),
+            Feat::T(u32::MAX),
+            Feat::OP(0, 5),
+            Feat::OP(1, 0),
+            Feat::OE(2, 9),
+            Feat::OT(0, 1),
+            Feat::Half(0),
+            Feat::Half(4),
+        ];
+        for a in &f {
+            for b in &f {
+                assert_eq!(a.cmp(b), a.code().cmp(&b.code()), "{a:?} vs {b:?}");
+            }
         }
     }
 
