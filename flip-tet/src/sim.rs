@@ -13,13 +13,15 @@ use rayon::prelude::*;
 use crate::advect::{advect, g2p, AdvectMesh, TetField};
 use crate::bcc::{tetrahedralize, TetMesh};
 use crate::error::{Result, SimError};
+use crate::inflow::EmitterState;
+use crate::obstacle::Obstacles;
 use crate::octree::{balance_2to1, build_octree, Octree, OctreeSpec, SizeDemand};
 use crate::particles::{apply_obstacles, apply_walls, classify_ballistic, position_correction, Particles};
-use crate::pressure::{apply_pressure, assemble_pressure, PressureSolver, SolveReport, W_MIN};
+use crate::pressure::{add_solid_flux, apply_pressure, assemble_pressure, PressureSolver, SolveReport, W_MIN};
 use crate::scene::{BoxFace, DtPolicy, Scene, Shape, TimeIntegration};
 use crate::sizing::{Sizing, SizingContext, SurfaceCurvature, C_H};
 use crate::split_merge::{split_merge, OldLevelSet};
-use crate::surface::{level_set_on_nodes, level_set_on_nodes_sign_inside, liquid_volume, tet_liquid_volume, Walls};
+use crate::surface::{level_set_on_nodes, level_set_on_nodes_sign_inside, liquid_volume, Walls};
 use crate::transfer::{blend_weak, extrapolate, node_average, particles_to_tets, sample};
 
 /// Liquid density used for the energies (kg/m³).
@@ -136,6 +138,13 @@ pub struct FlipTetSim {
     /// The obstacle-metric demands ([`Self::obstacle_demands`]): the obstacles are static and
     /// those metrics read only the solid SDF and the level sizes, so they are sampled once.
     obstacle_demands: Vec<SizeDemand>,
+    /// Every obstacle (static, mesh, moving), placed at the current time.
+    obstacles: Obstacles,
+    /// Inflow emitters (issue 26).
+    emitters: Vec<EmitterState>,
+    /// Volume of the particles deleted by the outflow regions (m³), also counted in
+    /// `deleted_volume`.
+    pub outflow_volume: f64,
     octree: Octree,
     mesh: TetMesh,
     h_tet: Vec<f64>,
@@ -180,7 +189,7 @@ fn face_index(f: BoxFace) -> usize {
 /// Samples every leaf inside the liquid with 2×2×2 particles of radius `h_leaf/4` at the sub-cube
 /// centres (spec S1a), jittered by `jitter · 2r`, shifted by `lattice_offset · 2r` (spec S1b);
 /// optional standing-wave column stretching.
-fn sample_particles(scene: &Scene, oct: &Octree, rng: &mut Rng) -> Particles {
+fn sample_particles(scene: &Scene, obstacles: &Obstacles, oct: &Octree, rng: &mut Rng) -> Particles {
     let mut p = Particles::default();
     let jit = scene.particles.sampling_jitter;
     let off = Vec3::from(scene.particles.lattice_offset);
@@ -201,7 +210,7 @@ fn sample_particles(scene: &Scene, oct: &Octree, rng: &mut Rng) -> Particles {
             // The shift (zero by default: `x + 0 = x` bitwise for every non-(−0) coordinate) moves
             // the kept particle; membership, velocity and φ_p are those of the unshifted point.
             let xs = x + off * (2.0 * r);
-            if d < 0.0 && scene.solid_sdf(&xs) > r {
+            if d < 0.0 && obstacles.sdf(&xs) > r {
                 p.push(xs, scene.velocity_at(&x), r, scene.initial_phi(&x));
             }
         }
@@ -374,16 +383,18 @@ impl FlipTetSim {
         for f in &scene.open_faces {
             open[face_index(*f)] = true;
         }
+        let obstacles = Obstacles::new(scene)?;
         let obstacle_demands = {
+            // The obstacle metrics are sampled once: from the static obstacles only.
             let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
-            let solid = |x: &Pt3| scene.solid_sdf(x);
+            let solid = |x: &Pt3| obstacles.static_sdf(x);
             if !scene.obstacles.is_empty() {
                 ctx.solid_sdf = Some(&solid);
             }
             Self::obstacle_demands(scene, &spec, &sizing, &ctx)
         };
         let mut octree = Octree::uniform(spec, 0);
-        let mut parts = sample_particles(scene, &octree, &mut rng.clone());
+        let mut parts = sample_particles(scene, &obstacles, &octree, &mut rng.clone());
         if spec.levels > 1 {
             for _ in 0..12 {
                 // Curvature sizing needs a surface at t = 0: the analytic liquid SDF on the current mesh.
@@ -403,8 +414,8 @@ impl FlipTetSim {
                 };
                 let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
                 ctx.surface = curv.as_ref();
-                let solid = |x: &Pt3| scene.solid_sdf(x);
-                if !scene.obstacles.is_empty() {
+                let solid = |x: &Pt3| obstacles.sdf(x);
+                if !obstacles.is_empty() {
                     ctx.solid_sdf = Some(&solid);
                 }
                 let mut demands =
@@ -416,7 +427,7 @@ impl FlipTetSim {
                 }
                 let same = next.leaves == octree.leaves;
                 octree = next;
-                parts = sample_particles(scene, &octree, &mut rng.clone());
+                parts = sample_particles(scene, &obstacles, &octree, &mut rng.clone());
                 if same {
                     break;
                 }
@@ -429,6 +440,14 @@ impl FlipTetSim {
             spec,
             sizing,
             obstacle_demands,
+            emitters: scene
+                .emitters
+                .iter()
+                .enumerate()
+                .map(|(k, e)| EmitterState::new(e, spec.h_min() / C_H, scene.seed ^ (k as u64 + 1)))
+                .collect(),
+            obstacles,
+            outflow_volume: 0.0,
             octree: octree.clone(),
             mesh: TetMesh::default(),
             h_tet: Vec::new(),
@@ -458,18 +477,8 @@ impl FlipTetSim {
 
     fn set_mesh(&mut self, oct: Octree) -> Result<()> {
         let mut mesh = tetrahedralize(&oct)?;
-        if !self.scene.obstacles.is_empty() {
-            let sdf: Vec<f64> = mesh.nodes.par_iter().map(|x| self.scene.solid_sdf(x)).collect();
-            let w: Vec<f64> = (0..mesh.tets.len())
-                .into_par_iter()
-                .map(|t| {
-                    let tv = mesh.tets[t];
-                    let p = tv.map(|i| mesh.nodes[i as usize]);
-                    let v = tv.map(|i| -sdf[i as usize]);
-                    (tet_liquid_volume(&p, &v) / mesh.volume[t]).clamp(0.0, 1.0)
-                })
-                .collect();
-            mesh.solid_frac = Some(w);
+        if !self.obstacles.is_empty() {
+            mesh.solid_frac = Some(self.obstacles.fluid_fractions(&mesh));
         }
         self.h_tet = mesh.tet_level.iter().map(|&l| self.spec.h(l)).collect();
         self.nodal_u = vec![Vec3::zeros(); mesh.nodes.len()];
@@ -676,13 +685,14 @@ impl FlipTetSim {
                 None => 0.0,
             }
         };
-        let solid = |x: &Pt3| self.scene.solid_sdf(x);
+        let obstacles = &self.obstacles;
+        let solid = |x: &Pt3| obstacles.sdf(x);
         let mut ctx = SizingContext::new(self.spec.h_min(), self.spec.h_root);
         ctx.time = self.time;
         ctx.u_ref = (self.scene.g().norm() * self.h_ref.max(self.spec.h_min())).sqrt();
         ctx.surface = curv.as_ref();
         ctx.vorticity = Some(&vort);
-        if !self.scene.obstacles.is_empty() {
+        if !self.obstacles.is_empty() {
             ctx.solid_sdf = Some(&solid);
         }
         let mut demands = Self::demands_static(
@@ -743,6 +753,13 @@ impl FlipTetSim {
         );
         let dt = self.choose_dt();
         tm.ballistic = c.elapsed().as_secs_f64();
+        // Moving obstacles: placed at the step's start, solid fractions rebuilt (issue 26).
+        if self.obstacles.any_moving() {
+            let c = Instant::now();
+            self.obstacles.set_time(self.time);
+            self.mesh.solid_frac = Some(self.obstacles.fluid_fractions(&self.mesh));
+            tm.remesh += c.elapsed().as_secs_f64();
+        }
         // 2. Level set on the nodes, stored at particles.
         let c = Instant::now();
         self.phi = self.level_set();
@@ -804,7 +821,10 @@ impl FlipTetSim {
         } else {
             std::borrow::Cow::Borrowed(&self.phi)
         };
-        let sys = assemble_pressure(&self.mesh, &phi_p, &u, self.spec.h_min(), &self.scene.pressure);
+        let mut sys = assemble_pressure(&self.mesh, &phi_p, &u, self.spec.h_min(), &self.scene.pressure);
+        if let Some(us) = self.obstacles.tet_velocities(&self.mesh) {
+            add_solid_flux(&self.mesh, &mut sys, &us);
+        }
         tm.assemble = c.elapsed().as_secs_f64();
         let c = Instant::now();
         let warm = self.warm.as_ref().map(|(nodes, q)| {
@@ -869,9 +889,26 @@ impl FlipTetSim {
         let subs = advect(&grid, &mut self.parts, new_field, old_field, g * dt_kick, dt);
         st.cfl_substeps = subs.iter().sum();
         let keep = apply_walls(&mut self.parts, &self.scene.min(), &self.scene.max(), &self.open);
-        if !self.scene.obstacles.is_empty() {
+        let mut keep = keep;
+        if !self.obstacles.is_empty() {
+            // Pushed out of the obstacles where they are at the step's end, with their velocity.
+            self.obstacles.set_time(self.time + dt);
+            let ob = &self.obstacles;
+            if ob.any_moving() {
+                apply_obstacles(&mut self.parts, &|x: &Pt3| ob.sdf(x), Some(&|x: &Pt3| ob.sdf_velocity(x).1));
+            } else {
+                apply_obstacles(&mut self.parts, &|x: &Pt3| ob.sdf(x), None);
+            }
+        }
+        if !self.scene.outflow.is_empty() {
             let sc = &self.scene;
-            apply_obstacles(&mut self.parts, &|x: &Pt3| sc.solid_sdf(x));
+            let out: Vec<bool> = self.parts.x.par_iter().map(|x| sc.outflow.iter().any(|s| s.sdf(x) < 0.0)).collect();
+            for (i, o) in out.iter().enumerate() {
+                if *o && keep[i] {
+                    keep[i] = false;
+                    self.outflow_volume += self.parts.volume(i);
+                }
+            }
         }
         let deleted = keep.iter().filter(|&&k| !k).count();
         if deleted > 0 {
@@ -880,6 +917,9 @@ impl FlipTetSim {
             self.parts.retain(&keep);
         }
         st.n_deleted = deleted;
+        for e in &mut self.emitters {
+            e.emit(self.time + dt, &mut self.parts);
+        }
         self.relocate();
         tm.advect = c.elapsed().as_secs_f64();
         // 11. Position correction.
@@ -991,6 +1031,22 @@ impl FlipTetSim {
         }
         let (t, l) = self.mesh.locate(&self.octree, x)?;
         Some(sample(&self.mesh, &self.tet_u, &self.nodal_u, t, &l))
+    }
+
+    /// The obstacles, placed at the current time.
+    pub fn obstacles(&self) -> &Obstacles {
+        &self.obstacles
+    }
+
+    /// Force (N) and torque (N·m, about the obstacle's moved centre) of the last projection's
+    /// gauge pressure on obstacle `k` ([`Obstacles::pressure_force`]).
+    pub fn obstacle_force(&self, k: usize) -> (Vec3, Vec3) {
+        self.obstacles.pressure_force(k, &self.mesh, &self.pressure)
+    }
+
+    /// Volume emitted by the inflow emitters so far (m³).
+    pub fn emitted_volume(&self) -> f64 {
+        self.emitters.iter().map(EmitterState::emitted_volume).sum()
     }
 
     /// Gauge pressure of the last projection at the mesh nodes (Pa; 0 at air and solid nodes).
