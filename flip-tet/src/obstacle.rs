@@ -238,7 +238,17 @@ impl Obstacles {
     /// Fluid fraction `w_t` per tet (spec §3.3: the volume fraction outside the obstacles of the
     /// linear interpolant of the union SDF at the nodes).
     pub fn fluid_fractions(&self, mesh: &TetMesh) -> Vec<f64> {
-        let sdf: Vec<f64> = mesh.nodes.par_iter().map(|x| self.sdf(x)).collect();
+        let sdf = self.node_sdf(mesh);
+        Self::fluid_fractions_from(mesh, &sdf)
+    }
+
+    /// The union SDF at the mesh nodes (m).
+    pub fn node_sdf(&self, mesh: &TetMesh) -> Vec<f64> {
+        mesh.nodes.par_iter().map(|x| self.sdf(x)).collect()
+    }
+
+    /// [`Self::fluid_fractions`] from the node SDF values `sdf`.
+    pub fn fluid_fractions_from(mesh: &TetMesh, sdf: &[f64]) -> Vec<f64> {
         (0..mesh.tets.len())
             .into_par_iter()
             .map(|t| {

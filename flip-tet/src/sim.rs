@@ -140,6 +140,8 @@ pub struct FlipTetSim {
     obstacle_demands: Vec<SizeDemand>,
     /// Every obstacle (static, mesh, moving), placed at the current time.
     obstacles: Obstacles,
+    /// The obstacles' union SDF at the mesh nodes (m; empty without obstacles).
+    node_sdf: Vec<f64>,
     /// Inflow emitters (issue 26).
     emitters: Vec<EmitterState>,
     /// Volume of the particles deleted by the outflow regions (m³), also counted in
@@ -421,6 +423,7 @@ impl FlipTetSim {
                 let mut demands =
                     Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx), None);
                 demands.extend_from_slice(&obstacle_demands);
+                demands.extend(Self::moving_obstacle_demands(&obstacles, scene, &spec));
                 let mut next = build_octree(spec, &demands);
                 if scene.extra_grading_layers > 0 {
                     balance_2to1(&mut next, scene.extra_grading_layers);
@@ -447,6 +450,7 @@ impl FlipTetSim {
                 .map(|(k, e)| EmitterState::new(e, spec.h_min() / C_H, scene.seed ^ (k as u64 + 1)))
                 .collect(),
             obstacles,
+            node_sdf: Vec::new(),
             outflow_volume: 0.0,
             octree: octree.clone(),
             mesh: TetMesh::default(),
@@ -478,7 +482,8 @@ impl FlipTetSim {
     fn set_mesh(&mut self, oct: Octree) -> Result<()> {
         let mut mesh = tetrahedralize(&oct)?;
         if !self.obstacles.is_empty() {
-            mesh.solid_frac = Some(self.obstacles.fluid_fractions(&mesh));
+            self.node_sdf = self.obstacles.node_sdf(&mesh);
+            mesh.solid_frac = Some(Obstacles::fluid_fractions_from(&mesh, &self.node_sdf));
         }
         self.h_tet = mesh.tet_level.iter().map(|&l| self.spec.h(l)).collect();
         self.nodal_u = vec![Vec3::zeros(); mesh.nodes.len()];
@@ -554,6 +559,33 @@ impl FlipTetSim {
             .collect()
     }
 
+    /// Finest-level demands along the surfaces of the moving obstacles (issue 26): every centre
+    /// of a finest cube of the domain within `1.5 h_min` of a moving obstacle's surface asks
+    /// for the finest level, so that a thin moving plate (a gate) is seen by the linear
+    /// interpolant of its SDF wherever it is (in a coarse tet it vanishes and the liquid leaks
+    /// through it). Sampled at every remesh from the obstacles' current placement; empty (no
+    /// cost) without moving obstacles.
+    fn moving_obstacle_demands(obstacles: &Obstacles, scene: &Scene, spec: &OctreeSpec) -> Vec<SizeDemand> {
+        if !obstacles.any_moving() || spec.levels <= 1 {
+            return Vec::new();
+        }
+        let h_min = spec.h_min();
+        let ext = scene.max() - scene.min();
+        let n = [0, 1, 2].map(|a| (ext[a] / h_min).round().max(1.0) as usize);
+        let cover = 0.5 * 3f64.sqrt() * h_min;
+        let level = spec.levels - 1;
+        let moving: Vec<usize> = (0..obstacles.len()).filter(|&k| obstacles.is_moving(k)).collect();
+        (0..n[0] * n[1] * n[2])
+            .into_par_iter()
+            .filter_map(|k| {
+                let (i, j, l) = (k % n[0], (k / n[0]) % n[1], k / (n[0] * n[1]));
+                let x = scene.min() + Vec3::new(i as f64 + 0.5, j as f64 + 0.5, l as f64 + 0.5) * h_min;
+                let d = moving.iter().map(|&m| obstacles.sdf_of(m, &x).abs()).fold(f64::INFINITY, f64::min);
+                (d <= 1.5 * h_min).then(|| SizeDemand { center: x, pad: 2.0 * h_min + cover, level })
+            })
+            .collect()
+    }
+
     fn walls(&self) -> [bool; 6] {
         self.open.map(|o| !o)
     }
@@ -565,9 +597,17 @@ impl FlipTetSim {
     /// The node level set; `exact_interior` evaluates every node (the reference the fast path is
     /// tested against).
     fn level_set_with(&self, exact_interior: bool) -> Vec<f64> {
+        // Nodes inside the obstacles, and within the finest particle radius of their surface
+        // (issue 26): the particles stop `r` short of an obstacle, so the particle level set puts
+        // a free surface (φ ≈ 0) along a liquid–obstacle contact; those nodes take the mean φ of
+        // their other neighbours instead, so the liquid sees a wall there, not a free surface.
+        let r_min = self.spec.h_min() / C_H;
         let solid: Option<Vec<bool>> = self.mesh.solid_frac.as_ref().map(|w| {
             (0..self.mesh.nodes.len())
-                .map(|i| self.mesh.node_tets.row(i).iter().all(|&t| w[t as usize] < W_MIN))
+                .map(|i| {
+                    self.node_sdf.get(i).is_some_and(|&d| d <= r_min)
+                        || self.mesh.node_tets.row(i).iter().all(|&t| w[t as usize] < W_MIN)
+                })
                 .collect()
         });
         let walls = Walls {
@@ -705,6 +745,7 @@ impl FlipTetSim {
             Some(&self.octree),
         );
         demands.extend_from_slice(&self.obstacle_demands);
+        demands.extend(Self::moving_obstacle_demands(&self.obstacles, &self.scene, &self.spec));
         let mut oct = build_octree(self.spec, &demands);
         if self.scene.extra_grading_layers > 0 {
             balance_2to1(&mut oct, self.scene.extra_grading_layers);
@@ -757,7 +798,8 @@ impl FlipTetSim {
         if self.obstacles.any_moving() {
             let c = Instant::now();
             self.obstacles.set_time(self.time);
-            self.mesh.solid_frac = Some(self.obstacles.fluid_fractions(&self.mesh));
+            self.node_sdf = self.obstacles.node_sdf(&self.mesh);
+            self.mesh.solid_frac = Some(Obstacles::fluid_fractions_from(&self.mesh, &self.node_sdf));
             tm.remesh += c.elapsed().as_secs_f64();
         }
         // 2. Level set on the nodes, stored at particles.

@@ -149,6 +149,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     s.num("paddle_hydrostatic_N", hydro);
     s.num("paddle_force_x_rest_N", f_rest);
     s.num("paddle_force_rel_err_rest", (f_rest - hydro).abs() / hydro);
+    let rest_speed: Vec<f64> = run_pad.stats.iter().filter(|x| x.t <= start + 1e-9).map(|x| x.max_speed).collect();
+    s.num("max_speed_paddle_rest", stats::max(&rest_speed));
     let moving: Vec<f64> = f_pad.iter().filter(|x| x.0 > start + 1e-9).map(|x| x.1.x).collect();
     s.num("paddle_force_x_max_moving_N", stats::max(&moving));
     sanity(&mut s, &run_pad.stats, "paddle");
