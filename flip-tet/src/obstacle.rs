@@ -99,7 +99,9 @@ fn shape_center(s: &Shape, mesh: Option<&MeshQuery>) -> Pt3 {
             let b = q.bbox();
             Pt3::from((b.min.coords + b.max.coords) / 2.0)
         }
-        (Shape::Box { min, max }, _) => Pt3::new((min[0] + max[0]) / 2.0, (min[1] + max[1]) / 2.0, (min[2] + max[2]) / 2.0),
+        (Shape::Box { min, max }, _) => {
+            Pt3::new((min[0] + max[0]) / 2.0, (min[1] + max[1]) / 2.0, (min[2] + max[2]) / 2.0)
+        }
         (Shape::Sphere { center, .. }, _) => Pt3::new(center[0], center[1], center[2]),
         (Shape::Cylinder { a, b, .. }, _) => Pt3::new((a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0, (a[2] + b[2]) / 2.0),
         (Shape::Subtract { base, .. }, _) => shape_center(base, None),

@@ -443,7 +443,8 @@ impl Scene {
         {
             return bad("liquid/obstacles/outflow: non-finite or non-positive shape parameter");
         }
-        if self.liquid.iter().chain(self.moving_liquid.iter().map(|(s, _)| s)).chain(&self.outflow).any(Shape::has_mesh) {
+        if self.liquid.iter().chain(self.moving_liquid.iter().map(|(s, _)| s)).chain(&self.outflow).any(Shape::has_mesh)
+        {
             return bad("liquid/moving_liquid/outflow: Mesh shapes are allowed only as obstacles");
         }
         for (k, s) in self.obstacles.iter().enumerate() {

@@ -52,7 +52,9 @@ pub struct Params {
 /// at `speed` from `t = 0`.
 pub fn gate_scene(scene: &Scene, thickness: f64, speed: f64) -> Result<Scene> {
     if !(thickness.is_finite() && thickness > 0.0 && speed.is_finite()) {
-        return Err(SimError::InvalidScene("dam-break-gate: gate_thickness > 0 and a finite gate_speed required".into()));
+        return Err(SimError::InvalidScene(
+            "dam-break-gate: gate_thickness > 0 and a finite gate_speed required".into(),
+        ));
     }
     let a = column_width(scene)?;
     let (lo, hi) = (scene.domain.min, scene.domain.max);

@@ -134,9 +134,11 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     sanity(&mut s, &run_mesh.stats, "mesh");
     // 3. Paddle at rest, then moving.
     let pad = sized_scene(&p.paddle, &p.finest, None, &p.paddle_duration, size);
-    let start = pad.moving_obstacles.first().map(|m| rest_until(&m.path)).ok_or_else(|| {
-        SimError::InvalidScene("obstacle-force: the paddle scene needs a moving obstacle".into())
-    })?;
+    let start = pad
+        .moving_obstacles
+        .first()
+        .map(|m| rest_until(&m.path))
+        .ok_or_else(|| SimError::InvalidScene("obstacle-force: the paddle scene needs a moving obstacle".into()))?;
     let depth = match pad.liquid.first() {
         Some(Shape::Box { min, max }) => max[1] - min[1],
         _ => return Err(SimError::InvalidScene("obstacle-force: the paddle's liquid must be a Box".into())),
