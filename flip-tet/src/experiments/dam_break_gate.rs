@@ -113,9 +113,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     sanity(&mut s, &dr.run.stats, "gate");
     crate::metrics::run_figures(&mut s, &dr.run.stats, dr.run.wall);
     let fa = ("T = t sqrt(2g/a)", "Z = x/a");
-    for (tag, label, data) in FRONT_DATA {
+    for (_, label, data) in FRONT_DATA {
         plot(rec, "front_vs_literature", label, fa, (false, false), data.to_vec())?;
-        let _ = tag;
     }
     plot(rec, "front_vs_literature", "simulation, gate lifted", fa, (false, false), dr.front.clone())?;
     plot(
