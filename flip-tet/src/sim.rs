@@ -1394,7 +1394,7 @@ mod tests {
             liquid: [Box(min: (0.0, 0.0, 0.0), max: (1.0, 0.25, 0.5))])"#;
         let base: Scene = ron::from_str(text).expect("test scene parses");
         let oct = Octree::uniform(OctreeSpec::new(base.min(), base.max(), 8, 8).unwrap(), 0);
-        let a = sample_particles(&base, &oct, &mut Rng::new(1));
+        let a = sample_particles(&base, &Obstacles::default(), &oct, &mut Rng::new(1));
         // 8 × 2 × 4 cubes of h = 1/8 below y = 0.25, 8 particles each.
         assert_eq!(a.len(), 8 * 2 * 4 * 8);
         let top = a.x.iter().map(|x| x.y).fold(f64::MIN, f64::max);
@@ -1402,7 +1402,7 @@ mod tests {
         let mut shifted = base.clone();
         shifted.particles.lattice_offset = [0.1, 0.37, -0.2];
         shifted.validate().expect("offset inside (−1, 1) is valid");
-        let b = sample_particles(&shifted, &oct, &mut Rng::new(1));
+        let b = sample_particles(&shifted, &Obstacles::default(), &oct, &mut Rng::new(1));
         assert_eq!(b.len(), a.len());
         let off = Vec3::new(0.1, 0.37, -0.2);
         for i in 0..a.len() {
