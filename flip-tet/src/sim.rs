@@ -581,7 +581,7 @@ impl FlipTetSim {
                 let (i, j, l) = (k % n[0], (k / n[0]) % n[1], k / (n[0] * n[1]));
                 let x = scene.min() + Vec3::new(i as f64 + 0.5, j as f64 + 0.5, l as f64 + 0.5) * h_min;
                 let d = moving.iter().map(|&m| obstacles.sdf_of(m, &x).abs()).fold(f64::INFINITY, f64::min);
-                (d <= 1.5 * h_min).then(|| SizeDemand { center: x, pad: 2.0 * h_min + cover, level })
+                (d <= 1.5 * h_min).then_some(SizeDemand { center: x, pad: 2.0 * h_min + cover, level })
             })
             .collect()
     }
