@@ -9,7 +9,9 @@ pub mod error;
 pub mod experiments;
 #[cfg(feature = "fvm-baseline")]
 pub mod fvm_baseline;
+pub mod inflow;
 pub mod metrics;
+pub mod obstacle;
 pub mod octree;
 pub mod ops;
 pub mod particles;

@@ -168,7 +168,15 @@ pub fn apply_walls(parts: &mut Particles, min: &Pt3, max: &Pt3, open: &[bool; 6]
 
 /// Pushes particles out of obstacles (spec §3.8): if `φ_s(x) < r`, move along the SDF gradient
 /// by `r − φ_s` and remove the velocity component into the solid.
-pub fn apply_obstacles(parts: &mut Particles, sdf: &(dyn Fn(&Pt3) -> f64 + Sync)) {
+///
+/// With `solid_velocity` (moving obstacles, issue 26) the particle keeps its velocity relative
+/// to the obstacle's there: only an approaching relative normal velocity `(v − v_s)·n < 0` is
+/// removed, so a particle the obstacle pushes moves with it.
+pub fn apply_obstacles(
+    parts: &mut Particles,
+    sdf: &(dyn Fn(&Pt3) -> f64 + Sync),
+    solid_velocity: Option<&(dyn Fn(&Pt3) -> Vec3 + Sync)>,
+) {
     parts.x.par_iter_mut().zip(parts.v.par_iter_mut()).zip(parts.r.par_iter()).for_each(|((x, v), &r)| {
         let d = sdf(x);
         if d < r {
@@ -181,8 +189,9 @@ pub fn apply_obstacles(parts: &mut Particles, sdf: &(dyn Fn(&Pt3) -> f64 + Sync)
             let nn = n.norm();
             if nn > 0.0 {
                 let n = n / nn;
+                let vs = solid_velocity.map_or_else(Vec3::zeros, |f| f(x));
                 *x += n * (r - d);
-                let vn = v.dot(&n);
+                let vn = (*v - vs).dot(&n);
                 if vn < 0.0 {
                     *v -= n * vn;
                 }

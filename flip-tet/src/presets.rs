@@ -88,7 +88,11 @@ pub fn rest_pool() -> rest_pool::Params {
             jitter_finest: None,
             finest: Some(sizes(16, 16, 32)),
         },
-        probes: Probes { heights: vec![(0.5, 0.125)], pressures: vec![[0.5, 0.1, 0.125], [0.25, 0.2, 0.0625]] },
+        probes: Probes {
+            heights: vec![(0.5, 0.125)],
+            pressures: vec![[0.5, 0.1, 0.125], [0.25, 0.2, 0.0625]],
+            obstacle_forces: false,
+        },
     }
 }
 

@@ -614,6 +614,35 @@ fn rel_res(a: &Csr, x: &[f64], b: &[f64]) -> f64 {
     }
 }
 
+/// Adds the flux of moving obstacles to the right-hand side (issue 26): the projection keeps
+/// `Gᵀ (W u + (V − W) u_solid) = 0`, so `b = Gᵀ W u* + Gᵀ (V − W) u_solid`, i.e. each DOF of a
+/// tet gains `V_t (1 − w_t) ∇λ_a · u_solid,t` (`w_t < W_MIN` counts as a solid tet, `w = 0`,
+/// as in the matrix). `u_solid` holds one velocity per tet (m/s; zero for static obstacles).
+/// Pinned DOFs keep a zero right-hand side.
+pub fn add_solid_flux(mesh: &TetMesh, sys: &mut PressureSystem, u_solid: &[Vec3]) {
+    for (t, tv) in mesh.tets.iter().enumerate() {
+        let us = u_solid[t];
+        if us == Vec3::zeros() {
+            continue;
+        }
+        let w = fluid_fraction(mesh, t);
+        let w = if w < W_MIN { 0.0 } else { w };
+        if w >= 1.0 {
+            continue;
+        }
+        let g = &mesh.grad_bary[t];
+        for a in 0..4 {
+            let d = sys.dof_of_node[tv[a] as usize];
+            if d != NONE {
+                sys.rhs[d as usize] += mesh.volume[t] * (1.0 - w) * g[a].dot(&us);
+            }
+        }
+    }
+    for &pd in &sys.pinned {
+        sys.rhs[pd as usize] = 0.0;
+    }
+}
+
 /// Nodal pressure values `q̂` seen by tet `t` (liquid DOF values, ghost values at air vertices,
 /// spec §3.4–3.5).
 pub fn tet_pressures(mesh: &TetMesh, sys: &PressureSystem, q: &[f64], t: usize) -> [f64; 4] {

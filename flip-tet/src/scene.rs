@@ -75,6 +75,15 @@ pub enum Shape {
         /// Removed shapes.
         holes: Vec<Shape>,
     },
+    /// A closed triangle mesh read from `path` (OBJ, PLY, OFF; a relative path resolves against
+    /// the scene file's folder, [`Scene::resolve_paths`]), for obstacles only (top level of
+    /// `obstacles` or of a moving obstacle's `shape`). Its signed distance is geom-core's
+    /// `MeshQuery::signed_distance`, evaluated through [`crate::obstacle::Obstacles`], which
+    /// loads the file; [`Shape::sdf`] itself knows no mesh and returns +∞.
+    Mesh {
+        /// Mesh file.
+        path: String,
+    },
 }
 
 fn p3(a: &[f64; 3]) -> Pt3 {
@@ -105,6 +114,16 @@ impl Shape {
                 }
                 d
             }
+            Shape::Mesh { .. } => f64::INFINITY,
+        }
+    }
+
+    /// Whether the shape is or contains a `Mesh`.
+    pub fn has_mesh(&self) -> bool {
+        match self {
+            Shape::Mesh { .. } => true,
+            Shape::Subtract { base, holes } => base.has_mesh() || holes.iter().any(Shape::has_mesh),
+            _ => false,
         }
     }
 
@@ -119,6 +138,7 @@ impl Shape {
                 [mean, amplitude, length, x0].iter().all(|v| v.is_finite()) && *length > 0.0
             }
             Shape::Subtract { base, holes } => base.finite() && holes.iter().all(Shape::finite),
+            Shape::Mesh { path } => !path.is_empty(),
         }
     }
 }
@@ -315,6 +335,15 @@ pub struct Scene {
     /// Static obstacles (union).
     #[serde(default)]
     pub obstacles: Vec<Shape>,
+    /// Obstacles moving on rigid paths (issue 26; [`crate::obstacle`]).
+    #[serde(default)]
+    pub moving_obstacles: Vec<crate::obstacle::MovingObstacle>,
+    /// Inflow emitters (issue 26; [`crate::inflow`]).
+    #[serde(default)]
+    pub emitters: Vec<crate::inflow::Emitter>,
+    /// Outflow regions: particles whose centre enters one are deleted (issue 26).
+    #[serde(default)]
+    pub outflow: Vec<Shape>,
     /// Box faces through which particles may leave.
     #[serde(default)]
     pub open_faces: Vec<BoxFace>,
@@ -365,6 +394,9 @@ impl Scene {
             initial_velocity: [0.0; 3],
             moving_liquid: Vec::new(),
             obstacles: Vec::new(),
+            moving_obstacles: Vec::new(),
+            emitters: Vec::new(),
+            outflow: Vec::new(),
             open_faces: Vec::new(),
             extra_grading_layers: 0,
             sizing: SizingParams::default(),
@@ -406,10 +438,32 @@ impl Scene {
         if !self.gravity.iter().chain(&self.initial_velocity).all(|v| v.is_finite()) {
             return bad("gravity/initial_velocity: non-finite");
         }
-        if !self.liquid.iter().chain(&self.obstacles).all(Shape::finite)
+        if !self.liquid.iter().chain(&self.obstacles).chain(&self.outflow).all(Shape::finite)
             || !self.moving_liquid.iter().all(|(s, v)| s.finite() && v.iter().all(|x| x.is_finite()))
         {
-            return bad("liquid/obstacles: non-finite or non-positive shape parameter");
+            return bad("liquid/obstacles/outflow: non-finite or non-positive shape parameter");
+        }
+        if self.liquid.iter().chain(self.moving_liquid.iter().map(|(s, _)| s)).chain(&self.outflow).any(Shape::has_mesh)
+        {
+            return bad("liquid/moving_liquid/outflow: Mesh shapes are allowed only as obstacles");
+        }
+        for (k, s) in self.obstacles.iter().enumerate() {
+            if let Shape::Subtract { .. } = s {
+                if s.has_mesh() {
+                    return Err(SimError::InvalidScene(format!("obstacles[{k}]: a Mesh cannot be part of a Subtract")));
+                }
+            }
+        }
+        for (k, m) in self.moving_obstacles.iter().enumerate() {
+            if !m.shape.finite() || (matches!(m.shape, Shape::Subtract { .. }) && m.shape.has_mesh()) {
+                return Err(SimError::InvalidScene(format!(
+                    "moving_obstacles[{k}].shape: non-finite parameter or a Mesh inside a Subtract"
+                )));
+            }
+            m.path.validate().map_err(|e| SimError::InvalidScene(format!("moving_obstacles[{k}].path: {e}")))?;
+        }
+        for (k, e) in self.emitters.iter().enumerate() {
+            e.validate(&format!("emitters[{k}]")).map_err(SimError::InvalidScene)?;
         }
         let f = &self.flip;
         if !(f.cfl > 0.0 && f.cfl.is_finite() && f.dt_max > 0.0 && f.dt_min > 0.0 && f.dt_min <= f.dt_max) {
@@ -497,8 +551,28 @@ impl Scene {
         Vec3::new(self.initial_velocity[0], self.initial_velocity[1], self.initial_velocity[2])
     }
 
-    /// Obstacle SDF (+∞ without obstacles).
+    /// SDF of the static analytic obstacles (+∞ without; `Mesh` obstacles and moving obstacles
+    /// are not included: the simulator evaluates every obstacle through
+    /// [`crate::obstacle::Obstacles`]).
     pub fn solid_sdf(&self, x: &Pt3) -> f64 {
         union_sdf(&self.obstacles, x)
+    }
+
+    /// Whether the scene has any obstacle (static, mesh or moving).
+    pub fn has_obstacles(&self) -> bool {
+        !self.obstacles.is_empty() || !self.moving_obstacles.is_empty()
+    }
+
+    /// Makes every relative `Mesh` path absolute against `dir` (the scene file's folder).
+    pub fn resolve_paths(&mut self, dir: &std::path::Path) {
+        let fix = |s: &mut Shape| {
+            if let Shape::Mesh { path } = s {
+                if std::path::Path::new(path.as_str()).is_relative() {
+                    *path = dir.join(path.as_str()).to_string_lossy().into_owned();
+                }
+            }
+        };
+        self.obstacles.iter_mut().for_each(fix);
+        self.moving_obstacles.iter_mut().for_each(|m| fix(&mut m.shape));
     }
 }

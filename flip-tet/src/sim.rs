@@ -13,13 +13,15 @@ use rayon::prelude::*;
 use crate::advect::{advect, g2p, AdvectMesh, TetField};
 use crate::bcc::{tetrahedralize, TetMesh};
 use crate::error::{Result, SimError};
+use crate::inflow::EmitterState;
+use crate::obstacle::Obstacles;
 use crate::octree::{balance_2to1, build_octree, Octree, OctreeSpec, SizeDemand};
 use crate::particles::{apply_obstacles, apply_walls, classify_ballistic, position_correction, Particles};
-use crate::pressure::{apply_pressure, assemble_pressure, PressureSolver, SolveReport, W_MIN};
+use crate::pressure::{add_solid_flux, apply_pressure, assemble_pressure, PressureSolver, SolveReport, W_MIN};
 use crate::scene::{BoxFace, DtPolicy, Scene, Shape, TimeIntegration};
 use crate::sizing::{Sizing, SizingContext, SurfaceCurvature, C_H};
 use crate::split_merge::{split_merge, OldLevelSet};
-use crate::surface::{level_set_on_nodes, level_set_on_nodes_sign_inside, liquid_volume, tet_liquid_volume, Walls};
+use crate::surface::{level_set_on_nodes, level_set_on_nodes_sign_inside, liquid_volume, Walls};
 use crate::transfer::{blend_weak, extrapolate, node_average, particles_to_tets, sample};
 
 /// Liquid density used for the energies (kg/m³).
@@ -136,6 +138,15 @@ pub struct FlipTetSim {
     /// The obstacle-metric demands ([`Self::obstacle_demands`]): the obstacles are static and
     /// those metrics read only the solid SDF and the level sizes, so they are sampled once.
     obstacle_demands: Vec<SizeDemand>,
+    /// Every obstacle (static, mesh, moving), placed at the current time.
+    obstacles: Obstacles,
+    /// The obstacles' union SDF at the mesh nodes (m; empty without obstacles).
+    node_sdf: Vec<f64>,
+    /// Inflow emitters (issue 26).
+    emitters: Vec<EmitterState>,
+    /// Volume of the particles deleted by the outflow regions (m³), also counted in
+    /// `deleted_volume`.
+    pub outflow_volume: f64,
     octree: Octree,
     mesh: TetMesh,
     h_tet: Vec<f64>,
@@ -180,7 +191,7 @@ fn face_index(f: BoxFace) -> usize {
 /// Samples every leaf inside the liquid with 2×2×2 particles of radius `h_leaf/4` at the sub-cube
 /// centres (spec S1a), jittered by `jitter · 2r`, shifted by `lattice_offset · 2r` (spec S1b);
 /// optional standing-wave column stretching.
-fn sample_particles(scene: &Scene, oct: &Octree, rng: &mut Rng) -> Particles {
+fn sample_particles(scene: &Scene, obstacles: &Obstacles, oct: &Octree, rng: &mut Rng) -> Particles {
     let mut p = Particles::default();
     let jit = scene.particles.sampling_jitter;
     let off = Vec3::from(scene.particles.lattice_offset);
@@ -201,7 +212,7 @@ fn sample_particles(scene: &Scene, oct: &Octree, rng: &mut Rng) -> Particles {
             // The shift (zero by default: `x + 0 = x` bitwise for every non-(−0) coordinate) moves
             // the kept particle; membership, velocity and φ_p are those of the unshifted point.
             let xs = x + off * (2.0 * r);
-            if d < 0.0 && scene.solid_sdf(&xs) > r {
+            if d < 0.0 && obstacles.sdf(&xs) > r {
                 p.push(xs, scene.velocity_at(&x), r, scene.initial_phi(&x));
             }
         }
@@ -374,16 +385,18 @@ impl FlipTetSim {
         for f in &scene.open_faces {
             open[face_index(*f)] = true;
         }
+        let obstacles = Obstacles::new(scene)?;
         let obstacle_demands = {
+            // The obstacle metrics are sampled once: from the static obstacles only.
             let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
-            let solid = |x: &Pt3| scene.solid_sdf(x);
+            let solid = |x: &Pt3| obstacles.static_sdf(x);
             if !scene.obstacles.is_empty() {
                 ctx.solid_sdf = Some(&solid);
             }
             Self::obstacle_demands(scene, &spec, &sizing, &ctx)
         };
         let mut octree = Octree::uniform(spec, 0);
-        let mut parts = sample_particles(scene, &octree, &mut rng.clone());
+        let mut parts = sample_particles(scene, &obstacles, &octree, &mut rng.clone());
         if spec.levels > 1 {
             for _ in 0..12 {
                 // Curvature sizing needs a surface at t = 0: the analytic liquid SDF on the current mesh.
@@ -403,20 +416,21 @@ impl FlipTetSim {
                 };
                 let mut ctx = SizingContext::new(spec.h_min(), spec.h_root);
                 ctx.surface = curv.as_ref();
-                let solid = |x: &Pt3| scene.solid_sdf(x);
-                if !scene.obstacles.is_empty() {
+                let solid = |x: &Pt3| obstacles.sdf(x);
+                if !obstacles.is_empty() {
                     ctx.solid_sdf = Some(&solid);
                 }
                 let mut demands =
                     Self::demands_static(scene, &spec, &sizing, &parts, scene.flip.dt_max, Some(&ctx), None);
                 demands.extend_from_slice(&obstacle_demands);
+                demands.extend(Self::moving_obstacle_demands(&obstacles, scene, &spec));
                 let mut next = build_octree(spec, &demands);
                 if scene.extra_grading_layers > 0 {
                     balance_2to1(&mut next, scene.extra_grading_layers);
                 }
                 let same = next.leaves == octree.leaves;
                 octree = next;
-                parts = sample_particles(scene, &octree, &mut rng.clone());
+                parts = sample_particles(scene, &obstacles, &octree, &mut rng.clone());
                 if same {
                     break;
                 }
@@ -429,6 +443,15 @@ impl FlipTetSim {
             spec,
             sizing,
             obstacle_demands,
+            emitters: scene
+                .emitters
+                .iter()
+                .enumerate()
+                .map(|(k, e)| EmitterState::new(e, spec.h_min() / C_H, scene.seed ^ (k as u64 + 1)))
+                .collect(),
+            obstacles,
+            node_sdf: Vec::new(),
+            outflow_volume: 0.0,
             octree: octree.clone(),
             mesh: TetMesh::default(),
             h_tet: Vec::new(),
@@ -458,18 +481,9 @@ impl FlipTetSim {
 
     fn set_mesh(&mut self, oct: Octree) -> Result<()> {
         let mut mesh = tetrahedralize(&oct)?;
-        if !self.scene.obstacles.is_empty() {
-            let sdf: Vec<f64> = mesh.nodes.par_iter().map(|x| self.scene.solid_sdf(x)).collect();
-            let w: Vec<f64> = (0..mesh.tets.len())
-                .into_par_iter()
-                .map(|t| {
-                    let tv = mesh.tets[t];
-                    let p = tv.map(|i| mesh.nodes[i as usize]);
-                    let v = tv.map(|i| -sdf[i as usize]);
-                    (tet_liquid_volume(&p, &v) / mesh.volume[t]).clamp(0.0, 1.0)
-                })
-                .collect();
-            mesh.solid_frac = Some(w);
+        if !self.obstacles.is_empty() {
+            self.node_sdf = self.obstacles.node_sdf(&mesh);
+            mesh.solid_frac = Some(Obstacles::fluid_fractions_from(&mesh, &self.node_sdf));
         }
         self.h_tet = mesh.tet_level.iter().map(|&l| self.spec.h(l)).collect();
         self.nodal_u = vec![Vec3::zeros(); mesh.nodes.len()];
@@ -545,6 +559,33 @@ impl FlipTetSim {
             .collect()
     }
 
+    /// Finest-level demands along the surfaces of the moving obstacles (issue 26): every centre
+    /// of a finest cube of the domain within `1.5 h_min` of a moving obstacle's surface asks
+    /// for the finest level, so that a thin moving plate (a gate) is seen by the linear
+    /// interpolant of its SDF wherever it is (in a coarse tet it vanishes and the liquid leaks
+    /// through it). Sampled at every remesh from the obstacles' current placement; empty (no
+    /// cost) without moving obstacles.
+    fn moving_obstacle_demands(obstacles: &Obstacles, scene: &Scene, spec: &OctreeSpec) -> Vec<SizeDemand> {
+        if !obstacles.any_moving() || spec.levels <= 1 {
+            return Vec::new();
+        }
+        let h_min = spec.h_min();
+        let ext = scene.max() - scene.min();
+        let n = [0, 1, 2].map(|a| (ext[a] / h_min).round().max(1.0) as usize);
+        let cover = 0.5 * 3f64.sqrt() * h_min;
+        let level = spec.levels - 1;
+        let moving: Vec<usize> = (0..obstacles.len()).filter(|&k| obstacles.is_moving(k)).collect();
+        (0..n[0] * n[1] * n[2])
+            .into_par_iter()
+            .filter_map(|k| {
+                let (i, j, l) = (k % n[0], (k / n[0]) % n[1], k / (n[0] * n[1]));
+                let x = scene.min() + Vec3::new(i as f64 + 0.5, j as f64 + 0.5, l as f64 + 0.5) * h_min;
+                let d = moving.iter().map(|&m| obstacles.sdf_of(m, &x).abs()).fold(f64::INFINITY, f64::min);
+                (d <= 1.5 * h_min).then_some(SizeDemand { center: x, pad: 2.0 * h_min + cover, level })
+            })
+            .collect()
+    }
+
     fn walls(&self) -> [bool; 6] {
         self.open.map(|o| !o)
     }
@@ -556,9 +597,17 @@ impl FlipTetSim {
     /// The node level set; `exact_interior` evaluates every node (the reference the fast path is
     /// tested against).
     fn level_set_with(&self, exact_interior: bool) -> Vec<f64> {
+        // Nodes inside the obstacles, and within the finest particle radius of their surface
+        // (issue 26): the particles stop `r` short of an obstacle, so the particle level set puts
+        // a free surface (φ ≈ 0) along a liquid–obstacle contact; those nodes take the mean φ of
+        // their other neighbours instead, so the liquid sees a wall there, not a free surface.
+        let r_min = self.spec.h_min() / C_H;
         let solid: Option<Vec<bool>> = self.mesh.solid_frac.as_ref().map(|w| {
             (0..self.mesh.nodes.len())
-                .map(|i| self.mesh.node_tets.row(i).iter().all(|&t| w[t as usize] < W_MIN))
+                .map(|i| {
+                    self.node_sdf.get(i).is_some_and(|&d| d <= r_min)
+                        || self.mesh.node_tets.row(i).iter().all(|&t| w[t as usize] < W_MIN)
+                })
                 .collect()
         });
         let walls = Walls {
@@ -676,13 +725,14 @@ impl FlipTetSim {
                 None => 0.0,
             }
         };
-        let solid = |x: &Pt3| self.scene.solid_sdf(x);
+        let obstacles = &self.obstacles;
+        let solid = |x: &Pt3| obstacles.sdf(x);
         let mut ctx = SizingContext::new(self.spec.h_min(), self.spec.h_root);
         ctx.time = self.time;
         ctx.u_ref = (self.scene.g().norm() * self.h_ref.max(self.spec.h_min())).sqrt();
         ctx.surface = curv.as_ref();
         ctx.vorticity = Some(&vort);
-        if !self.scene.obstacles.is_empty() {
+        if !self.obstacles.is_empty() {
             ctx.solid_sdf = Some(&solid);
         }
         let mut demands = Self::demands_static(
@@ -695,6 +745,7 @@ impl FlipTetSim {
             Some(&self.octree),
         );
         demands.extend_from_slice(&self.obstacle_demands);
+        demands.extend(Self::moving_obstacle_demands(&self.obstacles, &self.scene, &self.spec));
         let mut oct = build_octree(self.spec, &demands);
         if self.scene.extra_grading_layers > 0 {
             balance_2to1(&mut oct, self.scene.extra_grading_layers);
@@ -743,6 +794,14 @@ impl FlipTetSim {
         );
         let dt = self.choose_dt();
         tm.ballistic = c.elapsed().as_secs_f64();
+        // Moving obstacles: placed at the step's start, solid fractions rebuilt (issue 26).
+        if self.obstacles.any_moving() {
+            let c = Instant::now();
+            self.obstacles.set_time(self.time);
+            self.node_sdf = self.obstacles.node_sdf(&self.mesh);
+            self.mesh.solid_frac = Some(Obstacles::fluid_fractions_from(&self.mesh, &self.node_sdf));
+            tm.remesh += c.elapsed().as_secs_f64();
+        }
         // 2. Level set on the nodes, stored at particles.
         let c = Instant::now();
         self.phi = self.level_set();
@@ -804,7 +863,10 @@ impl FlipTetSim {
         } else {
             std::borrow::Cow::Borrowed(&self.phi)
         };
-        let sys = assemble_pressure(&self.mesh, &phi_p, &u, self.spec.h_min(), &self.scene.pressure);
+        let mut sys = assemble_pressure(&self.mesh, &phi_p, &u, self.spec.h_min(), &self.scene.pressure);
+        if let Some(us) = self.obstacles.tet_velocities(&self.mesh) {
+            add_solid_flux(&self.mesh, &mut sys, &us);
+        }
         tm.assemble = c.elapsed().as_secs_f64();
         let c = Instant::now();
         let warm = self.warm.as_ref().map(|(nodes, q)| {
@@ -869,9 +931,26 @@ impl FlipTetSim {
         let subs = advect(&grid, &mut self.parts, new_field, old_field, g * dt_kick, dt);
         st.cfl_substeps = subs.iter().sum();
         let keep = apply_walls(&mut self.parts, &self.scene.min(), &self.scene.max(), &self.open);
-        if !self.scene.obstacles.is_empty() {
+        let mut keep = keep;
+        if !self.obstacles.is_empty() {
+            // Pushed out of the obstacles where they are at the step's end, with their velocity.
+            self.obstacles.set_time(self.time + dt);
+            let ob = &self.obstacles;
+            if ob.any_moving() {
+                apply_obstacles(&mut self.parts, &|x: &Pt3| ob.sdf(x), Some(&|x: &Pt3| ob.sdf_velocity(x).1));
+            } else {
+                apply_obstacles(&mut self.parts, &|x: &Pt3| ob.sdf(x), None);
+            }
+        }
+        if !self.scene.outflow.is_empty() {
             let sc = &self.scene;
-            apply_obstacles(&mut self.parts, &|x: &Pt3| sc.solid_sdf(x));
+            let out: Vec<bool> = self.parts.x.par_iter().map(|x| sc.outflow.iter().any(|s| s.sdf(x) < 0.0)).collect();
+            for (i, o) in out.iter().enumerate() {
+                if *o && keep[i] {
+                    keep[i] = false;
+                    self.outflow_volume += self.parts.volume(i);
+                }
+            }
         }
         let deleted = keep.iter().filter(|&&k| !k).count();
         if deleted > 0 {
@@ -880,6 +959,9 @@ impl FlipTetSim {
             self.parts.retain(&keep);
         }
         st.n_deleted = deleted;
+        for e in &mut self.emitters {
+            e.emit(self.time + dt, &mut self.parts);
+        }
         self.relocate();
         tm.advect = c.elapsed().as_secs_f64();
         // 11. Position correction.
@@ -991,6 +1073,22 @@ impl FlipTetSim {
         }
         let (t, l) = self.mesh.locate(&self.octree, x)?;
         Some(sample(&self.mesh, &self.tet_u, &self.nodal_u, t, &l))
+    }
+
+    /// The obstacles, placed at the current time.
+    pub fn obstacles(&self) -> &Obstacles {
+        &self.obstacles
+    }
+
+    /// Force (N) and torque (N·m, about the obstacle's moved centre) of the last projection's
+    /// gauge pressure on obstacle `k` ([`Obstacles::pressure_force`]).
+    pub fn obstacle_force(&self, k: usize) -> (Vec3, Vec3) {
+        self.obstacles.pressure_force(k, &self.mesh, &self.pressure)
+    }
+
+    /// Volume emitted by the inflow emitters so far (m³).
+    pub fn emitted_volume(&self) -> f64 {
+        self.emitters.iter().map(EmitterState::emitted_volume).sum()
     }
 
     /// Gauge pressure of the last projection at the mesh nodes (Pa; 0 at air and solid nodes).
@@ -1296,7 +1394,7 @@ mod tests {
             liquid: [Box(min: (0.0, 0.0, 0.0), max: (1.0, 0.25, 0.5))])"#;
         let base: Scene = ron::from_str(text).expect("test scene parses");
         let oct = Octree::uniform(OctreeSpec::new(base.min(), base.max(), 8, 8).unwrap(), 0);
-        let a = sample_particles(&base, &oct, &mut Rng::new(1));
+        let a = sample_particles(&base, &Obstacles::default(), &oct, &mut Rng::new(1));
         // 8 × 2 × 4 cubes of h = 1/8 below y = 0.25, 8 particles each.
         assert_eq!(a.len(), 8 * 2 * 4 * 8);
         let top = a.x.iter().map(|x| x.y).fold(f64::MIN, f64::max);
@@ -1304,7 +1402,7 @@ mod tests {
         let mut shifted = base.clone();
         shifted.particles.lattice_offset = [0.1, 0.37, -0.2];
         shifted.validate().expect("offset inside (−1, 1) is valid");
-        let b = sample_particles(&shifted, &oct, &mut Rng::new(1));
+        let b = sample_particles(&shifted, &Obstacles::default(), &oct, &mut Rng::new(1));
         assert_eq!(b.len(), a.len());
         let off = Vec3::new(0.1, 0.37, -0.2);
         for i in 0..a.len() {

@@ -23,7 +23,11 @@ fn pressure_probe_reads_hydrostatics_in_a_resting_pool() {
     for _ in 0..4 {
         sim.step().unwrap();
     }
-    let probes = Probes { heights: vec![(0.5, 0.125)], pressures: vec![[0.5, 0.1, 0.125], [0.3, 0.05, 0.1]] };
+    let probes = Probes {
+        heights: vec![(0.5, 0.125)],
+        pressures: vec![[0.5, 0.1, 0.125], [0.3, 0.05, 0.1]],
+        ..Default::default()
+    };
     let (h, p) = probes.sample(&sim);
     assert!((h[0] - 0.25).abs() <= 1e-9, "{h:?}");
     for (q, v) in probes.pressures.iter().zip(&p) {

@@ -162,7 +162,7 @@ pub fn simulate(
     let probe_table = format!("{}probes", out.dir);
     let mut probe_values = Vec::new();
     if let Some(p) = probes {
-        p.declare(rec, &probe_table)?;
+        p.declare(rec, &probe_table, sim.obstacles().len())?;
         let (h, pr) = p.record(&sim, rec, &probe_table)?;
         probe_values.push((sim.time(), h, pr));
     }

@@ -1,5 +1,6 @@
 //! Probes a scene can place (issue 26): the water height at given `(x, z)` columns and the gauge
-//! pressure at given points, sampled at every frame into the `probes` table (`probes.csv`).
+//! pressure at given points, and the force and torque of the liquid's pressure on every
+//! obstacle, sampled at every frame into the `probes` table (`probes.csv`).
 
 use geom_core::math::Pt3;
 use geom_core::record::{Cell, Recorder};
@@ -18,20 +19,45 @@ pub struct Probes {
     pub heights: Vec<(f64, f64)>,
     /// Points (m) whose gauge pressure (Pa) is recorded ([`FlipTetSim::pressure_at`]).
     pub pressures: Vec<[f64; 3]>,
+    /// Force (N) and torque (N·m, about the obstacle's moved centre) of the gauge pressure on
+    /// every obstacle ([`FlipTetSim::obstacle_force`]): columns `force_<k>_{x,y,z}_N`,
+    /// `torque_<k>_{x,y,z}_Nm` after the others.
+    pub obstacle_forces: bool,
 }
 
 impl Probes {
     /// Whether there is no probe.
     pub fn is_empty(&self) -> bool {
-        self.heights.is_empty() && self.pressures.is_empty()
+        self.heights.is_empty() && self.pressures.is_empty() && !self.obstacle_forces
     }
 
-    /// Column names: `t`, `height_<i>_m`, `pressure_<i>_Pa`.
-    pub fn header(&self) -> Vec<String> {
+    /// Column names: `t`, `height_<i>_m`, `pressure_<i>_Pa`, then with `obstacle_forces` for
+    /// each of the `n_obstacles` obstacles `force_<k>_{x,y,z}_N`, `torque_<k>_{x,y,z}_Nm`.
+    pub fn header(&self, n_obstacles: usize) -> Vec<String> {
         let mut h = vec!["t".to_string()];
         h.extend((0..self.heights.len()).map(|i| format!("height_{i}_m")));
         h.extend((0..self.pressures.len()).map(|i| format!("pressure_{i}_Pa")));
+        if self.obstacle_forces {
+            for k in 0..n_obstacles {
+                h.extend(["x", "y", "z"].map(|a| format!("force_{k}_{a}_N")));
+                h.extend(["x", "y", "z"].map(|a| format!("torque_{k}_{a}_Nm")));
+            }
+        }
         h
+    }
+
+    /// Forces and torques of every obstacle, flattened as in [`Self::header`] (empty without
+    /// `obstacle_forces`).
+    pub fn forces(&self, sim: &FlipTetSim) -> Vec<f64> {
+        if !self.obstacle_forces {
+            return Vec::new();
+        }
+        (0..sim.obstacles().len())
+            .flat_map(|k| {
+                let (f, t) = sim.obstacle_force(k);
+                [f.x, f.y, f.z, t.x, t.y, t.z]
+            })
+            .collect()
     }
 
     /// The probe values now: heights (m, NaN without liquid), pressures (Pa, NaN outside the mesh
@@ -44,8 +70,8 @@ impl Probes {
     }
 
     /// Declares the table `name`.
-    pub fn declare(&self, rec: &mut dyn Recorder, name: &str) -> Result<()> {
-        let header = self.header();
+    pub fn declare(&self, rec: &mut dyn Recorder, name: &str, n_obstacles: usize) -> Result<()> {
+        let header = self.header(n_obstacles);
         let cols: Vec<&str> = header.iter().map(String::as_str).collect();
         rec.table(name, &cols)?;
         Ok(())
@@ -55,7 +81,7 @@ impl Probes {
     pub fn record(&self, sim: &FlipTetSim, rec: &mut dyn Recorder, name: &str) -> Result<(Vec<f64>, Vec<f64>)> {
         let (h, p) = self.sample(sim);
         let mut row = vec![Cell::Num(sim.time())];
-        row.extend(h.iter().chain(&p).map(|&v| Cell::Num(v)));
+        row.extend(h.iter().chain(&p).chain(&self.forces(sim)).map(|&v| Cell::Num(v)));
         rec.row(name, &row)?;
         Ok((h, p))
     }

@@ -26,4 +26,17 @@ pub fn register(v: &mut Vec<Runner>) {
     v.push(Runner { method: "flip-tet/fvm-vs-nodal", run: |c| run_experiment(c, ex::fvm_vs_nodal::run) });
     v.push(Runner { method: "flip-tet/open-splash", run: |c| run_experiment(c, ex::open_splash::run) });
     v.push(Runner { method: "flip-tet/corridor-camera", run: |c| run_experiment(c, ex::corridor_camera::run) });
+    v.push(Runner { method: "flip-tet/dam-break-gate", run: |c| run_experiment(c, ex::dam_break_gate::run) });
+    v.push(Runner { method: "flip-tet/inflow", run: |c| run_experiment(c, ex::inflow::run) });
+    v.push(Runner {
+        method: "flip-tet/obstacle-force",
+        run: |c| {
+            // Mesh paths resolve against the scene file's folder.
+            run_experiment(c, |p: &ex::obstacle_force::Params, size, rec| {
+                let mut p = p.clone();
+                p.resolve_paths(&c.resolve("."));
+                ex::obstacle_force::run(&p, size, rec)
+            })
+        },
+    });
 }
