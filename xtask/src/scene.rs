@@ -51,7 +51,6 @@ impl Mode {
             Mode::Full => Size::Full,
         }
     }
-
 }
 
 /// The envelope every scene file shares.

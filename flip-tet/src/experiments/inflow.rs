@@ -10,10 +10,14 @@
 //! ```no_run
 //! use flip_tet::experiments::inflow;
 //! use geom_core::experiment::Size;
-//! let p: inflow::Params = unimplemented!("the scene file's params block");
+//! #[derive(serde::Deserialize)]
+//! struct File { params: inflow::Params }
+//! let text = std::fs::read_to_string("scenes/flip-tet/inflow.ron")?;
+//! let opts = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+//! let p = opts.from_str::<File>(&text)?.params;
 //! let r = inflow::run(&p, Size::Quick, &mut geom_core::record::NullRecorder::default())?;
 //! println!("delivered volume error {}", r.get_f64("inflow_volume_rel_err"));
-//! # Ok::<(), flip_tet::error::SimError>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 use geom_core::experiment::{BySize, Report, Size, Target};

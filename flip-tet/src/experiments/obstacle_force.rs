@@ -16,10 +16,14 @@
 //! ```no_run
 //! use flip_tet::experiments::obstacle_force;
 //! use geom_core::experiment::Size;
-//! let p: obstacle_force::Params = unimplemented!("the scene file's params block");
+//! #[derive(serde::Deserialize)]
+//! struct File { params: obstacle_force::Params }
+//! let text = std::fs::read_to_string("scenes/flip-tet/obstacle-force.ron")?;
+//! let opts = ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+//! let p = opts.from_str::<File>(&text)?.params;
 //! let r = obstacle_force::run(&p, Size::Quick, &mut geom_core::record::NullRecorder::default())?;
 //! println!("buoyancy error {}", r.get_f64("buoyancy_rel_err_box"));
-//! # Ok::<(), flip_tet::error::SimError>(())
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 use geom_core::experiment::{BySize, Report, Size, Target};
