@@ -8,19 +8,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let x = xavier()?;
     let g = xavier_guide(&x, 10.0)?;
     let rest = &x.mesh.positions;
-    let mut edges: Vec<(u32, u32)> = x
-        .mesh
-        .faces
-        .iter()
-        .flat_map(|f| (0..3).map(move |k| (f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3]))))
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
+    let edges = x.mesh.topology().edges();
     let mut p = vec![Pt3::origin(); rest.len()];
     for t in ts {
         g.sample(t, &mut p);
         let (mut smax, mut cmax) = (0.0f64, 0.0f64);
-        for &(a, b) in &edges {
+        for &[a, b] in edges {
             let s = (p[b as usize] - p[a as usize]).norm() / (rest[b as usize] - rest[a as usize]).norm() - 1.0;
             smax = smax.max(s);
             cmax = cmax.max(-s);

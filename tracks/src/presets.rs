@@ -135,16 +135,9 @@ pub fn ground_at(friction: f64, height: f64) -> Obstacle {
 /// constraint force grew by 2–4 N every step (2.2 → 27.7 N in 8 steps) and the edge strain
 /// reached 0.27; at y = 0 the first step fails (IPC needs a positive gap at the start).
 pub fn ground_below(mesh: &TriMesh) -> f64 {
-    let mut edges: Vec<(u32, u32)> = mesh
-        .faces
-        .iter()
-        .flat_map(|f| (0..3).map(move |k| (f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3]))))
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    let p = &mesh.positions;
+    let (edges, p) = (mesh.topology().edges(), &mesh.positions);
     let mean =
-        edges.iter().map(|&(a, b)| (p[b as usize] - p[a as usize]).norm()).sum::<f64>() / edges.len().max(1) as f64;
+        edges.iter().map(|&[a, b]| (p[b as usize] - p[a as usize]).norm()).sum::<f64>() / edges.len().max(1) as f64;
     -(shells::contact::contact_distance(0.0, mean) + 1e-3)
 }
 

@@ -337,17 +337,8 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
     let sanity = |s: &ShellSim| Sanity::new(&s.mesh().rest, &s.mesh().edges, obstacles.clone(), None);
     let mut san_t = sanity(&tr.sim);
     let mut san_u = un.as_ref().map(sanity);
-    let mut san_g = {
-        let gm = &setup.guide.rest;
-        let mut e: Vec<[u32; 2]> = gm
-            .faces
-            .iter()
-            .flat_map(|f| (0..3).map(move |k| [f[k].min(f[(k + 1) % 3]), f[k].max(f[(k + 1) % 3])]))
-            .collect();
-        e.sort_unstable();
-        e.dedup();
-        Sanity::new(&gm.positions, &e, Vec::new(), None)
-    };
+    let gm = &setup.guide.rest;
+    let mut san_g = Sanity::new(&gm.positions, gm.topology().edges(), Vec::new(), None);
     let k_lp = out.k.max(1);
     let lp = LowPass::new(&setup.tracked_rest, LowPass::tau_for(&setup.tracked_rest, k_lp))?;
     let h = setup.h();
