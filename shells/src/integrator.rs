@@ -164,4 +164,21 @@ pub trait VelocitySolve {
     fn merit(&mut self, _q: &[Pt3]) -> f64 {
         0.0
     }
+
+    /// Largest constraint violation the last [`solve`](Self::solve) had to restore, as a
+    /// velocity (m/s): max over constraint rows of ‖rᵢ‖ in C Δv = r. The IPC Newton loop stops
+    /// on its decrement test only when this is within `newton_tol` (a feasible iterate), so a
+    /// step that still pulls the cloth onto its constraints keeps iterating. 0 (the default)
+    /// for unconstrained solves.
+    fn constraint_violation(&self) -> f64 {
+        0.0
+    }
+
+    /// Whether [`solve`](Self::solve) accepts a system whose sparsity pattern changes between
+    /// calls (IPC contact couplings grow it, `ShellSim`'s pattern growth). A solver that keeps
+    /// a symbolic analysis of the mesh's own pattern returns false (the default); IPC then
+    /// lumps contact couplings onto the diagonal blocks for it, which costs Newton iterations.
+    fn accepts_pattern_changes(&self) -> bool {
+        false
+    }
 }

@@ -38,7 +38,7 @@ pub struct AugmentedLagrangian {
     /// Dimension (3 × free vertices).
     n: usize,
     /// Stored entries of the A it was built for (pattern-change check).
-    a_nnz: usize,
+    a_pattern: SparsityPattern,
     /// A + ρĈᵀĈ in A's storage convention (A's entries, plus the lower triangle of ĈᵀĈ).
     mat: Csc,
     /// Position in `mat` of each stored entry of A.
@@ -149,12 +149,23 @@ impl AugmentedLagrangian {
         let sym = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
         let mat: Csc = SparseColMat::new(sym, vec![0.0; nnz]);
         let llt = SparseLlt::analyze(&mat, Ordering::Amd)?;
-        Ok(Self { n, a_nnz: a.val().len(), mat, a_map, ctc, ctc_max_diag, llt, mu: vec![0.0; 3 * k], last_iters: 0 })
+        Ok(Self {
+            n,
+            a_pattern: SparsityPattern::of(a),
+            mat,
+            a_map,
+            ctc,
+            ctc_max_diag,
+            llt,
+            mu: vec![0.0; 3 * k],
+            last_iters: 0,
+        })
     }
 
-    /// Whether this cache was built for A's pattern (dimension and stored entries).
+    /// Whether this cache was built for A's pattern (dimension, column pointers and row
+    /// indices: IPC contact couplings change the pattern between Newton iterations).
     pub fn fits(&self, a: &Csc) -> bool {
-        self.n == a.nrows() && self.a_nnz == a.val().len()
+        self.n == a.nrows() && self.a_pattern.matches(a)
     }
 
     /// Stored entries of the LLᵀ factor of A_ρ.
@@ -237,6 +248,30 @@ impl AugmentedLagrangian {
             self.mu.iter_mut().zip(cx.iter().zip(&s2)).for_each(|(mu, (c, s))| *mu += rho * (c - s));
         }
         Ok((x, self.mu.clone(), res))
+    }
+}
+
+/// A copy of a sparse matrix's structure (column pointers and row indices), to tell whether a
+/// cached symbolic analysis still fits a matrix: the IPC contact model grows the system's
+/// pattern between Newton iterations (`shells::VelocitySolve::accepts_pattern_changes`), and two
+/// patterns can have the same number of stored entries.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct SparsityPattern {
+    col_ptr: Vec<usize>,
+    row_idx: Vec<usize>,
+}
+
+impl SparsityPattern {
+    /// The structure of `a`.
+    pub(crate) fn of(a: &Csc) -> Self {
+        let s = a.symbolic();
+        Self { col_ptr: s.col_ptr().to_vec(), row_idx: s.row_idx().to_vec() }
+    }
+
+    /// Whether `a` has exactly this structure.
+    pub(crate) fn matches(&self, a: &Csc) -> bool {
+        let s = a.symbolic();
+        s.col_ptr() == self.col_ptr.as_slice() && s.row_idx() == self.row_idx.as_slice()
     }
 }
 

@@ -22,7 +22,7 @@ use geom_core::math::{Pt3, Vec3};
 use geom_core::NONE;
 use shells::{ImplicitSystem, VelocitySolve};
 
-use crate::augmented::{c_mul, ct_mul, AugmentedLagrangian};
+use crate::augmented::{c_mul, ct_mul, AugmentedLagrangian, SparsityPattern};
 use crate::constraints::TrackingConstraints;
 use crate::guide::GuideAnimation;
 
@@ -139,6 +139,8 @@ struct KktCache {
     exact: Csc,
     factor_mat: Option<Csc>,
     a_map: Vec<usize>,
+    /// A's structure when this cache was built (rebuilt when IPC contact changes it).
+    a_pattern: SparsityPattern,
     /// The LDLᵀ (ConstraintLast, Interleaved, AmdRegularized, Compliant) or the bordered LLᵀ
     /// (Schur).
     factor: KktFactor,
@@ -182,6 +184,9 @@ pub struct TrackingSolver {
     merit_rho: f64,
     /// h_eff of the last solve (s): the merit's constraint values are g(q)/h_eff.
     merit_h: f64,
+    /// max ‖gᵢ(q_pred)‖/h_eff of the last solve (m/s): the violation its step restores
+    /// ([`VelocitySolve::constraint_violation`]).
+    violation: f64,
     /// Statistics of the last solve.
     pub last: KktStats,
 }
@@ -234,6 +239,7 @@ impl TrackingSolver {
             gbuf: vec![Pt3::origin(); nb],
             merit_rho: 0.0,
             merit_h: 1.0,
+            violation: 0.0,
             last: KktStats::default(),
         }
     }
@@ -364,12 +370,12 @@ impl TrackingSolver {
             KktMethod::AmdRegularizedLdlt { .. } | KktMethod::Compliant { .. } => Some(exact.clone()),
             _ => None,
         };
-        self.kkt = Some(KktCache { n, m, exact, factor_mat, a_map, factor });
+        self.kkt = Some(KktCache { n, m, exact, factor_mat, a_map, a_pattern: SparsityPattern::of(a), factor });
         Ok(())
     }
 
     fn solve_kkt(&mut self, sys: &ImplicitSystem, r: &[f64]) -> shells::Result<(Vec<f64>, Vec<f64>)> {
-        if self.kkt.as_ref().is_none_or(|k| k.a_map.len() != sys.a.val().len() || k.n != sys.a.nrows()) {
+        if self.kkt.as_ref().is_none_or(|k| k.n != sys.a.nrows() || !k.a_pattern.matches(sys.a)) {
             self.build_kkt(sys.a)?;
         }
         let method = self.method;
@@ -714,6 +720,26 @@ impl VelocitySolve for TrackingSolver {
         self.merit_rho * g.iter().map(|x| x.norm()).sum::<f64>() / self.merit_h
     }
 
+    fn constraint_violation(&self) -> f64 {
+        self.violation
+    }
+
+    /// True for the factorisations that analyse the KKT (or A_ρ) pattern they are given and
+    /// re-analyse when it changes; false for the methods that reuse the mesh pattern's
+    /// symbolic analysis of A (Schur, SchurPcg, the shadow LLᵀ) or cache their own once
+    /// (Penalty), and when a compared method is one of those.
+    fn accepts_pattern_changes(&self) -> bool {
+        let own = matches!(
+            self.method,
+            KktMethod::ConstraintLastLdlt
+                | KktMethod::InterleavedLdlt
+                | KktMethod::AmdRegularizedLdlt { .. }
+                | KktMethod::Compliant { .. }
+                | KktMethod::AugmentedLagrangian { .. }
+        );
+        own && !self.shadow && self.shadows.iter().all(|s| s.accepts_pattern_changes())
+    }
+
     fn solve(&mut self, sys: &ImplicitSystem) -> shells::Result<Vec<f64>> {
         let t0 = Instant::now();
         self.build_cft(sys);
@@ -721,6 +747,7 @@ impl VelocitySolve for TrackingSolver {
         let k = self.cons.len();
         let mut g = vec![Vec3::zeros(); k];
         self.cons.residual(&self.gbuf, sys.q_pred, &mut g);
+        self.violation = g.iter().map(|x| x.norm()).fold(0.0, f64::max) / sys.h_eff;
         let c = self.correction_fraction / sys.h_eff;
         let r: Vec<f64> = g.iter().flat_map(|gi| [c * gi.x, c * gi.y, c * gi.z]).collect();
         let (dv, mu) = self.solve_method(sys, &r)?;

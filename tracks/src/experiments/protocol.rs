@@ -200,6 +200,9 @@ pub struct PairOut {
     /// Per step: the untracked step's numeric factorisation + solve of A, summed over its Newton
     /// iterations (s; empty without the twin).
     pub untracked_factor_solve: Vec<f64>,
+    /// Per step: Newton iterations of the (tracked, untracked) step (untracked 0 without the
+    /// twin) — the step cost beside the per-iteration solve cost.
+    pub newton_iters: Vec<(u32, u32)>,
     /// Physical-sanity figures of the tracked cloth over every step (issue 20).
     pub sanity_tracked: Option<Sanity>,
     /// Physical-sanity figures of the untracked cloth over every step (`None` without the twin).
@@ -225,6 +228,23 @@ impl PairOut {
     /// ([`kkt_over_untracked_factor`]); NaN without the untracked twin.
     pub fn kkt_over_untracked_factor(&self) -> f64 {
         kkt_over_untracked_factor(&self.kkt_times, &self.untracked_factor_solve)
+    }
+    /// [`kkt_over_untracked_factor`] per Newton iteration: the median over steps of t_kkt /
+    /// iterations over the median of the untracked step's (factorisation + solve) / iterations
+    /// — the cost of one constrained solve against one unconstrained one, without the
+    /// difference in iteration counts the step figure includes. NaN without the twin.
+    pub fn kkt_over_untracked_factor_per_iteration(&self) -> f64 {
+        let per = |t: &[f64], it: fn(&(u32, u32)) -> u32| -> Vec<f64> {
+            t.iter().zip(&self.newton_iters).map(|(t, n)| t / f64::from(it(n).max(1))).collect()
+        };
+        kkt_over_untracked_factor(&per(&self.kkt_times, |n| n.0), &per(&self.untracked_factor_solve, |n| n.1))
+    }
+    /// Mean Newton iterations per step, (tracked, untracked); NaN when no step ran.
+    pub fn newton_iters_per_step(&self) -> (f64, f64) {
+        let mean = |f: fn(&(u32, u32)) -> u32| {
+            geom_core::stats::mean(&self.newton_iters.iter().map(|x| f64::from(f(x))).collect::<Vec<_>>())
+        };
+        (mean(|x| x.0), mean(|x| x.1))
     }
     /// Tracked wall time per frame (s).
     pub fn s_per_frame_tracked(&self) -> f64 {
@@ -271,8 +291,12 @@ impl PairOut {
         r.count("nnz_l", self.nnz_l as u64);
         r.count("guide_held", self.guide_held as u64);
         r.count("setup_warnings", self.warnings.len() as u64);
+        let (it_t, it_u) = self.newton_iters_per_step();
+        r.num("newton_iters_per_step_tracked", it_t);
         if !self.untracked_factor_solve.is_empty() {
             r.timing("kkt_over_untracked_factor", self.kkt_over_untracked_factor());
+            r.timing("kkt_over_untracked_factor_per_iteration", self.kkt_over_untracked_factor_per_iteration());
+            r.num("newton_iters_per_step_untracked", it_u);
         }
         self.report_sanity(r);
     }
@@ -360,6 +384,9 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
             "max_force",
             "ccd",
             "refine_steps",
+            "newton_iters_tracked",
+            "newton_iters_untracked",
+            "t_factor_solve_untracked",
         ],
     )?;
     rec.table(
@@ -398,17 +425,20 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
                     *acc = (acc.0 + c.t_solve, geom_core::stats::nan_max(acc.1, c.rel_diff), acc.2.max(c.nnz_l));
                 }
                 let mut tu = 0.0;
+                let mut iters_u = 0;
                 if let Some(u) = un.as_mut() {
                     let t0 = Instant::now();
                     let su = u.step(h)?;
                     tu = t0.elapsed().as_secs_f64();
                     out.t_untracked += tu;
                     out.untracked_factor_solve.push(su.t_factor + su.t_solve);
+                    iters_u = su.newton_iters;
                     if let Some(s) = san_u.as_mut() {
                         s.observe(&u.state().q, u.state().t, None);
                     }
                 }
                 out.steps += 1;
+                out.newton_iters.push((st.shell.newton_iters, iters_u));
                 out.step_times.push((st.t_step, tu));
                 rec.row(
                     &steps_t,
@@ -423,6 +453,9 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
                         Cell::from(st.max_constraint_force),
                         Cell::from(st.shell.n_ccd),
                         Cell::from(st.kkt_refine_steps),
+                        Cell::from(st.shell.newton_iters),
+                        Cell::from(iters_u),
+                        Cell::from(out.untracked_factor_solve.last().copied().unwrap_or(f64::NAN)),
                     ],
                 )?;
                 rec.progress(out.steps as u64, total);

@@ -176,6 +176,13 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         let n = setup.tracked_rest.n_vertices();
         r.timing(&format!("overhead_pct_{name}"), b.overhead_pct());
         r.timing(&format!("kkt_over_untracked_factor_{name}"), b.kkt_over_untracked_factor());
+        r.timing(
+            &format!("kkt_over_untracked_factor_per_iteration_{name}"),
+            b.kkt_over_untracked_factor_per_iteration(),
+        );
+        let (it_t, it_u) = b.newton_iters_per_step();
+        r.num(&format!("newton_iters_per_step_tracked_{name}"), it_t);
+        r.num(&format!("newton_iters_per_step_untracked_{name}"), it_u);
         r.timing(&format!("s_per_frame_tracked_{name}"), b.s_per_frame_tracked());
         r.timing(&format!("s_per_frame_untracked_{name}"), b.s_per_frame_untracked());
         rec.row(
