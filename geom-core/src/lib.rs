@@ -10,6 +10,7 @@
 
 #[cfg(feature = "anim")]
 pub mod anim;
+pub mod clock;
 pub mod cluster;
 #[cfg(feature = "parry")]
 pub mod collide;

@@ -23,14 +23,6 @@ fn arg<T: std::str::FromStr>(i: usize, default: T) -> T {
     std::env::args().nth(i).and_then(|s| s.parse().ok()).unwrap_or(default)
 }
 
-/// CPU time of the calling thread (s), from `/proc/thread-self/schedstat` (Linux).
-fn thread_cpu_s() -> f64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next().and_then(|x| x.parse::<f64>().ok()))
-        .map_or(0.0, |ns| ns * 1e-9)
-}
-
 fn main() -> motion_graph::Result<()> {
     let clips: usize = arg(1, 80);
     let n: usize = arg(2, 20);
@@ -99,7 +91,7 @@ fn main() -> motion_graph::Result<()> {
     let (mut times, mut errs, mut cpus) = (Vec::new(), Vec::new(), Vec::new());
     for (k, pb) in problems.iter().enumerate() {
         let t0 = Instant::now();
-        let c0 = thread_cpu_s();
+        let c0 = geom_core::clock::thread_cpu_s();
         let mut s = Search::new(&g, pb.clone(), SearchParams { rng_seed: 1 + k as u64, ..sp.clone() })?;
         let mut it = 0;
         let mut met = None;
@@ -117,7 +109,7 @@ fn main() -> motion_graph::Result<()> {
         }
         let st = met.unwrap_or(t0.elapsed().as_secs_f64());
         times.push(st);
-        let cpu = thread_cpu_s() - c0;
+        let cpu = geom_core::clock::thread_cpu_s() - c0;
         cpus.push(cpu);
         let Some(best) = s.best() else { continue };
         let Some(mut a) = assemble(&g, &best.path, Planar::identity(), sp.min_piece_frames) else { continue };

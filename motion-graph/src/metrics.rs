@@ -57,15 +57,6 @@ pub fn mean_speed(m: &Motion) -> f64 {
     path_len / m.duration().max(1e-9)
 }
 
-/// CPU time (s) of the calling thread so far, from `/proc/thread-self/schedstat` (Linux; `None`
-/// elsewhere). The search is single-threaded, so the difference over a search is its time on an
-/// idle core: reported beside the wall-clock times because the machine may be shared.
-pub fn thread_cpu_s() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    let ns: f64 = s.split_whitespace().next()?.parse().ok()?;
-    Some(ns * 1e-9)
-}
-
 /// The figures of a scene (the keys of `summary.json`).
 #[derive(Clone, Debug)]
 pub struct SceneFigures {

@@ -24,7 +24,6 @@
 
 pub mod align;
 pub mod cell;
-pub mod clock;
 pub mod control;
 pub mod dance;
 pub mod data;

@@ -43,10 +43,11 @@ use serde::Deserialize;
 use crate::assemble::{assemble, enforce_body, evaluate, fix_contacts, smooth, ClipStats};
 use crate::db::{Database, DbParams};
 use crate::graph::{FrameRef, GraphParams, MotionGraph};
-use crate::metrics::{mean_speed, thread_cpu_s, ProblemFigures, ProblemOutcome, SceneFigures};
+use crate::metrics::{mean_speed, ProblemFigures, ProblemOutcome, SceneFigures};
 use crate::problem::{random_mg1, BodyConstraint, HardConstraint, JointConstraint, Problem, Weights};
 use crate::search::{Search, SearchParams, Tolerance};
 use crate::{Error, Result};
+use geom_core::clock::thread_cpu_s;
 
 /// Where clips come from.
 #[derive(Clone, Debug, Deserialize)]
@@ -401,10 +402,8 @@ fn solve_one(
         }
     }
     let search_s = met_at.unwrap_or(t0.elapsed().as_secs_f64());
-    let search_cpu_s = match (cpu0, thread_cpu_s()) {
-        (Some(a), Some(b)) => Some(b - a),
-        _ => None,
-    };
+    // None where the thread clock cannot be read (NaN readings).
+    let search_cpu_s = Some(thread_cpu_s() - cpu0).filter(|c| c.is_finite());
     *repairs += s.repairs;
     let fail = |why: &str| ProblemOutcome::Failed {
         reason: format!("problem {k}: {why}"),

@@ -7,7 +7,7 @@
 //! `threads` (only the streaming DP of [`crate::stream`] uses it).
 //!
 //! Every time is measured as wall clock (`*_s`, what the checks use) and as the thread's CPU time
-//! (`*_cpu_s`, [`crate::clock::thread_cpu_s`]): on a shared machine the wall time includes the waits
+//! (`*_cpu_s`, [`geom_core::clock::thread_cpu_s`]): on a shared machine the wall time includes the waits
 //! for a core.
 //!
 //! Outputs: table `timing` (one row per length and mode), plot `time_vs_length`.
@@ -31,7 +31,6 @@ use geom_core::record::{Cell, Recorder, Series};
 use geom_core::stats::{linear_fit, loglog_fit};
 use serde::Deserialize;
 
-use crate::clock::thread_cpu_s;
 use crate::data::duet::{timed_dance, DuetParams};
 use crate::dp::{interpret, DpParams};
 use crate::error::Result;
@@ -40,6 +39,7 @@ use crate::handhold::close_hands;
 use crate::output::{propagate, target_points};
 use crate::presets::{dance_database, DanceDbParams};
 use crate::refine::refine;
+use geom_core::clock::thread_cpu_s;
 
 /// Parameters of PC-5 (the RON `params` block of `perf-control/dance-timing`).
 #[derive(Clone, Debug, Deserialize)]

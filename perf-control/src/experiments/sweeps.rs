@@ -16,7 +16,6 @@ use std::time::Instant;
 
 use geom_core::experiment::{BySize, Size};
 
-use crate::clock::thread_cpu_s;
 use crate::dance::grammar::DanceLabel;
 use crate::data::duet::{test_dances, DuetParams, DuetTruth};
 use crate::data::walk::HIP_WIDTH;
@@ -32,6 +31,7 @@ use crate::reduce::{ClusterBy, ClusterDistance, ClusterOptions, Representative};
 use crate::refine::refine;
 use crate::track::PointTrack;
 use crate::{hips_control, tracking_error};
+use geom_core::clock::thread_cpu_s;
 
 /// The walk sweeps' data: a database take (120 s, 40 s quick) and a held-out input (57 s, 20 s
 /// quick), both at 30 Hz.
