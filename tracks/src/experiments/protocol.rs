@@ -20,7 +20,8 @@ use shells::{ContactMethod, ShellSim};
 use crate::error::Result;
 use crate::kkt::KktMethod;
 use crate::metrics::{
-    guide_on_tracked, hinge_energies, kkt_over_untracked_factor, overhead_pct, overhead_pct_median, tug_index, LowPass,
+    centroid, guide_on_tracked, hinge_energies, kkt_over_untracked_factor, mean_speed, overhead_pct,
+    overhead_pct_median, tug_index, vertex_mask, LowPass,
 };
 use crate::presets::{frames_for, Setup, ShellOptions};
 use crate::tracker::{TrackOptions, Tracker};
@@ -126,6 +127,22 @@ pub struct PairOpts {
     pub anchors: Option<Vec<u32>>,
     /// Suffix of the table and sequence names (`""`, `"_averaged"`, `"_r16"` …).
     pub tag: String,
+    /// Vertex subsets of the tracked mesh whose figures are also measured on their own
+    /// ([`PairOut::subsets`]; e.g. Xavier's feet and body, the two halves of Fig. 5).
+    pub subsets: Vec<Vec<u32>>,
+}
+
+/// Per-frame figures of one vertex subset of the tracked run (frames ≥ 1).
+#[derive(Clone, Debug, Default)]
+pub struct SubsetSeries {
+    /// D_c restricted to the subset: area-RMS over its vertices of (L_τ d)_i, / L.
+    pub dc: Vec<f64>,
+    /// a_d restricted to the subset: area-RMS over its vertices of (d − L_τ d)_i (m).
+    pub ad: Vec<f64>,
+    /// Area-RMS ‖d‖ / L over the subset.
+    pub rms: Vec<f64>,
+    /// λ_eff of d itself restricted to the subset ([`LowPass::wavelength_subset`], m).
+    pub lambda_raw: Vec<f64>,
 }
 
 /// Figures of one lockstep run.
@@ -210,6 +227,16 @@ pub struct PairOut {
     /// Exact self-intersection count, max over the counted frames (every frame with
     /// `intersections`, otherwise every recorded frame and the last one), tracked / untracked.
     pub max_intersections: (u64, u64),
+    /// Per frame ≥ 1: centroid of the tracked cloth (m).
+    pub centroid_tracked: Vec<Pt3>,
+    /// Per frame ≥ 1: mean vertex speed of the tracked cloth (m/s).
+    pub speed_tracked: Vec<f64>,
+    /// Per frame ≥ 1: centroid of the untracked cloth (m; empty without the twin).
+    pub centroid_untracked: Vec<Pt3>,
+    /// Per frame ≥ 1: mean vertex speed of the untracked cloth (m/s; empty without the twin).
+    pub speed_untracked: Vec<f64>,
+    /// Per subset of [`PairOpts::subsets`]: its per-frame figures.
+    pub subsets: Vec<SubsetSeries>,
 }
 
 impl PairOut {
@@ -341,6 +368,9 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
     let mut san_g = Sanity::new(&gm.positions, gm.topology().edges(), Vec::new(), None);
     let k_lp = out.k.max(1);
     let lp = LowPass::new(&setup.tracked_rest, LowPass::tau_for(&setup.tracked_rest, k_lp))?;
+    let n_fine = setup.tracked_rest.n_vertices();
+    let masks: Vec<Vec<bool>> = o.subsets.iter().map(|s| vertex_mask(n_fine, s)).collect();
+    out.subsets = vec![SubsetSeries::default(); masks.len()];
     let h = setup.h();
     let faces = tr.sim.mesh().tris.clone();
     let mut gq = vec![Pt3::origin(); setup.guide.n_vertices()];
@@ -468,6 +498,22 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
             }
         }
         if frame > 0 {
+            out.centroid_tracked.push(centroid(q));
+            out.speed_tracked.push(mean_speed(&tr.sim.state().v));
+            if let Some(u) = un.as_ref() {
+                out.centroid_untracked.push(centroid(&u.state().q));
+                out.speed_untracked.push(mean_speed(&u.state().v));
+            }
+            if !masks.is_empty() {
+                let lo = lp.apply(&d)?;
+                let hi: Vec<Vec3> = d.iter().zip(&lo).map(|(a, b)| a - b).collect();
+                for (m, ss) in masks.iter().zip(out.subsets.iter_mut()) {
+                    ss.dc.push(lp.rms_subset(&lo, m) / out.scale);
+                    ss.ad.push(lp.rms_subset(&hi, m));
+                    ss.rms.push(lp.rms_subset(&d, m) / out.scale);
+                    ss.lambda_raw.push(lp.wavelength_subset(&d, m));
+                }
+            }
             out.dc_tracked.push(dc);
             out.dc_untracked.push(dcu);
             out.ad_tracked.push(ad);
@@ -526,6 +572,19 @@ pub fn run_standard(
     intersections: bool,
     rec: &mut dyn Recorder,
 ) -> Result<(PairOut, Report)> {
+    run_standard_with(p, size, setup, intersections, Vec::new(), rec)
+}
+
+/// [`run_standard`] that also measures the figures of vertex `subsets` of the tracked mesh
+/// ([`PairOut::subsets`]).
+pub fn run_standard_with(
+    p: &PairParams,
+    size: Size,
+    setup: &Setup,
+    intersections: bool,
+    subsets: Vec<Vec<u32>>,
+    rec: &mut dyn Recorder,
+) -> Result<(PairOut, Report)> {
     let frames = frames_for(p.duration.get(size), setup.fps);
     let o = PairOpts {
         frames,
@@ -535,6 +594,7 @@ pub fn run_standard(
         intersections,
         anchors: None,
         tag: String::new(),
+        subsets,
     };
     let out = run_pair(setup, &o, rec)?;
     out.record_deviation(rec)?;
