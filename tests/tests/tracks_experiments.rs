@@ -123,6 +123,37 @@ fn fig5_heterogeneous() {
     assert_eq!(r.get_f64("constraints"), 272.0);
 }
 
+/// A user's own guide (`tracks/track` on the committed `assets/guides/flag-preview.usda`, read
+/// through the user-file path): the guide loads at its frame rate, the residual is at solver
+/// precision, both twins stay physical.
+#[test]
+fn own_guide() {
+    let mut p: ex::track::Params = params("own-guide");
+    p.resolve_paths(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/tracks")));
+    let r = assert_thread_independent("own-guide", || {
+        ex::track::run(&p, Size::Tiny, &mut NullRecorder::default()).expect("own-guide")
+    });
+    assert_checks("own-guide", &r, SANITY);
+    assert_sanity_figures("own-guide", &r);
+    assert_eq!((r.get_f64("guide_vertices"), r.get_f64("guide_frames")), (35.0, 121.0));
+    assert_eq!(r.get_f64("guide_fps"), 30.0);
+    assert_eq!(r.get_f64("constraints"), 4.0);
+}
+
+/// Bad user input to `tracks/track` is an error naming what is wrong, never a panic.
+#[test]
+fn own_guide_bad_input() {
+    let mut p: ex::track::Params = params("own-guide");
+    p.guide = ex::track::GuideSource::Usd { path: "/nonexistent/guide.usda".into() };
+    let e = ex::track::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap_err().to_string();
+    assert!(e.contains("/nonexistent/guide.usda"), "{e}");
+    let mut p: ex::track::Params = params("own-guide");
+    p.resolve_paths(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/tracks")));
+    p.test_functions = ex::track::Design::Clustered { regions: 4, seed: 1 };
+    let e = ex::track::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap_err().to_string();
+    assert!(e.contains("identical meshes"), "{e}");
+}
+
 #[test]
 fn fig6_partitions() {
     let r = run("fig6-partitions", ex::fig6_partitions::run);

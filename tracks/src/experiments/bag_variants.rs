@@ -12,7 +12,8 @@
 //! `s_per_frame_cellophane_vinyl_over_vinyl` and the common variant keys. The spec's
 //! expectations as claims ([`Claims`]): `guide_self_intersects`, `tracked_intersection_free`,
 //! `silk_more_detail_than_vinyl` (mean a_d after 1.5 s), `rough_rest_same_cost` (cellophane's
-//! s/frame within ±15 % of vinyl's; a timing figure); `claims_met` / `claims_total`.
+//! s/frame within ±15 % of vinyl's; a timing figure); `claims_met` / `claims_total`. Wrinkle
+//! scale (ℓ_w = ℓ_c/4): `ad_wrinkle_mean_after_1_5s_<v>`, `ad_wrinkle_silk_over_vinyl_after_1_5s`.
 //!
 //! ```no_run
 //! use geom_core::experiment::Size;
@@ -173,6 +174,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         r.num(&format!("dc_mean_{n}"), dc_mean);
         r.num(&format!("ad_mean_after_1_5s_{n}"), ad);
         r.num(&format!("lambda_eff_mean_after_1_5s_{n}"), lam);
+        r.num(&format!("ad_wrinkle_mean_after_1_5s_{n}"), after(v, &v.out.ad_wrinkle_tracked));
         r.timing(&format!("s_per_frame_{n}"), v.out.s_per_frame_tracked());
         rec.row(
             "variants",
@@ -222,6 +224,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         _ => (f64::NAN, f64::NAN),
     };
     r.num("ad_silk_over_vinyl_after_1_5s", ratio);
+    let wr = |name: &str| find(&runs, name).map_or(f64::NAN, |v| after(v, &v.out.ad_wrinkle_tracked));
+    r.num("ad_wrinkle_silk_over_vinyl_after_1_5s", wr("silk") / wr("vinyl"));
     r.num("ad_silk_gt_vinyl_frame_fraction_after_1_5s", frac);
     let spf = |name: &str| find(&runs, name).map_or(f64::NAN, |v| v.out.s_per_frame_tracked());
     r.timing("s_per_frame_cellophane_over_vinyl", spf("cellophane") / spf("vinyl"));

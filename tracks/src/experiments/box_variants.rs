@@ -14,6 +14,10 @@
 //! (a_d(4.4 s)/a_d(2.5 s) ≤ 0.2, `kb_1`), `plastic_wrinkles_persist` (≥ 0.5,
 //! `plastic_<y>_eta_0`), `tracked_moves_after_guide_stops` (tracked KE > 0 after 4.5 s in every
 //! variant while the guide is still), `decay_faster_with_beta`; `claims_met` / `claims_total`.
+//! Wrinkle-scale figures (a_d and λ_eff with the filter scale ℓ_w = ℓ_c/4, see
+//! [`PairOut::ad_wrinkle_tracked`](super::protocol::PairOut::ad_wrinkle_tracked)):
+//! `ad_wrinkle_2_5s_<v>`, `lambda_wrinkle_2_5s_<v>`, `ad_wrinkle_ratio_4_4_over_2_5_<v>`,
+//! `wrinkle_lambda_monotone_in_kb`, `wrinkle_ad_ratio_4_4_over_2_5_{elastic,plastic}`.
 //!
 //! ```no_run
 //! use geom_core::experiment::Size;
@@ -201,6 +205,10 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         r.num(&format!("ke_decay_rate_per_s_{n}"), rate);
         r.timing(&format!("s_per_frame_{n}"), v.out.s_per_frame_tracked());
         r.num(&format!("bend_over_kb_2_5s_{n}"), bend_geo);
+        let w = &v.out.ad_wrinkle_tracked;
+        r.num(&format!("ad_wrinkle_2_5s_{n}"), v.at(T_TWISTED, w, fps));
+        r.num(&format!("lambda_wrinkle_2_5s_{n}"), v.at(T_TWISTED, &v.out.lambda_wrinkle_tracked, fps));
+        r.num(&format!("ad_wrinkle_ratio_4_4_over_2_5_{n}"), v.at(T_UNTWISTED, w, fps) / v.at(T_TWISTED, w, fps));
         rec.row(
             "variants",
             &[
@@ -272,6 +280,23 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let guide_motion = guide_motion_after(&guide, T_STOP, duration, fps);
     r.num("guide_motion_after_stop_m", guide_motion);
     common_keys(&mut r, &runs, &p.run, size, duration);
+    // The same expectations measured at the wrinkle scale (ℓ_w = ℓ_c/4; figures, not claims:
+    // they isolate whether the box-scale filter of a_d decides the claims above).
+    let lamw: Option<Vec<f64>> = kb
+        .iter()
+        .map(|&k| {
+            find(&runs, &format!("kb_{}", num_key(k))).map(|v| v.at(T_TWISTED, &v.out.lambda_wrinkle_tracked, fps))
+        })
+        .collect();
+    let monow = lamw.filter(|l| l.len() >= 2).map(|l| l.windows(2).all(|w| w[1] > w[0]));
+    r.num("wrinkle_lambda_monotone_in_kb", flag(monow));
+    let ratio_w = |name: &str| {
+        find(&runs, name).map_or(f64::NAN, |v| {
+            v.at(T_UNTWISTED, &v.out.ad_wrinkle_tracked, fps) / v.at(T_TWISTED, &v.out.ad_wrinkle_tracked, fps)
+        })
+    };
+    r.num("wrinkle_ad_ratio_4_4_over_2_5_elastic", ratio_w("kb_1"));
+    r.num("wrinkle_ad_ratio_4_4_over_2_5_plastic", plastic.as_deref().map_or(f64::NAN, ratio_w));
     claims.claim(&mut r, "tracked_moves_after_guide_stops", ke_positive == Some(true) && guide_motion == 0.0, src);
     claims.claim(&mut r, "decay_faster_with_beta", faster == Some(true), src);
     claims.finish(&mut r);

@@ -12,7 +12,9 @@
 //! of the 20 ended stuck on the branch), `tracked_stuck`, `untracked_stuck` (the fine runs by
 //! the same test, [`stuck_on_branch`]: centroid within 0.3 m of the branch axis, mean speed
 //! < 0.05 m/s over the last 0.5 s), `tracked_speed_last_0_5s_m_per_s`,
-//! `untracked_speed_last_0_5s_m_per_s`.
+//! `untracked_speed_last_0_5s_m_per_s` (mean vertex speed) and
+//! `{tracked,untracked}_centroid_speed_last_0_5s_m_per_s` (the centroid's own speed). Sequence
+//! `design_preview`: the chosen coarse preview at every frame.
 //!
 //! ```no_run
 //! use geom_core::experiment::Size;
@@ -54,6 +56,20 @@ pub fn preview_duration(size: Size) -> f64 {
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     p.validate("tracks/flag")?;
     let design = flag_design(preview_duration(size), p.contact)?;
+    // The chosen preview itself, every frame (sequence `design_preview`: its OBJ frames and
+    // `design_preview.usda` are the guide file a user would export from the preview tool; the
+    // built-in `tracks/own-guide` reads it back).
+    let g = &design.guide;
+    for (k, q) in g.frames.iter().enumerate() {
+        rec.frame(&geom_core::record::MeshFrame {
+            sequence: "design_preview",
+            index: k,
+            time: k as f64 / g.fps,
+            positions: q,
+            faces: &g.rest.faces,
+            attributes: &[],
+        })?;
+    }
     let setup = flag_setup(&design, &p.shell(size))?;
     let (out, mut r) = run_standard(p, size, &setup, false, rec)?;
     let last = |v: &[f64]| v.last().copied().unwrap_or(f64::NAN);
@@ -79,6 +95,13 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     };
     r.num("tracked_speed_last_0_5s_m_per_s", tail_speed(&out.speed_tracked));
     r.num("untracked_speed_last_0_5s_m_per_s", tail_speed(&out.speed_untracked));
+    // The centroid's own speed (the rigid drift of the whole cloth, without its inner motion).
+    let centroid_speed = |c: &[geom_core::math::Pt3]| {
+        let v: Vec<f64> = c.windows(2).map(|w| (w[1] - w[0]).norm() * FLAG_FPS).collect();
+        tail_speed(&v)
+    };
+    r.num("tracked_centroid_speed_last_0_5s_m_per_s", centroid_speed(&out.centroid_tracked));
+    r.num("untracked_centroid_speed_last_0_5s_m_per_s", centroid_speed(&out.centroid_untracked));
     r.check(
         "deviation_ratio_untracked_over_tracked",
         Target::AtLeast(3.0),

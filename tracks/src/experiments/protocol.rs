@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use geom_core::experiment::{BySize, Report, Size};
 use geom_core::math::{Pt3, Vec3};
-use geom_core::record::{Cell, MeshFrame, Recorder, Series};
+use geom_core::record::{Cell, MeshFrame, Recorder, SceneItem, Series};
 use serde::Deserialize;
 use shells::metrics::Sanity;
 use shells::{ContactMethod, ShellSim};
@@ -46,6 +46,15 @@ pub struct PairParams {
     /// The contact model of the fine shell (default IPC; `Bridson` = the seed's filter).
     #[serde(default)]
     pub contact: ContactMethod,
+    /// Also run the untracked twin (default true). Off, the untracked keys are absent (NaN
+    /// deviations): for tracked-only figures when the twin's cost does not fit (a crumpled
+    /// untracked Xavier costs 1.4–6.6 s per step on the ground).
+    #[serde(default = "yes")]
+    pub untracked: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl PairParams {
@@ -237,7 +246,17 @@ pub struct PairOut {
     pub speed_untracked: Vec<f64>,
     /// Per subset of [`PairOpts::subsets`]: its per-frame figures.
     pub subsets: Vec<SubsetSeries>,
+    /// Per frame ≥ 1: wrinkle-scale detail amplitude of the tracked run (m): a_d with the
+    /// filter scale ℓ_w = ℓ_c/4 ([`WRINKLE_REFINE`]: detail finer than the test functions
+    /// refined twice), so box-scale departures from the guide count as coarse.
+    pub ad_wrinkle_tracked: Vec<f64>,
+    /// Per frame ≥ 1: λ_eff of the wrinkle-scale detail (m).
+    pub lambda_wrinkle_tracked: Vec<f64>,
 }
+
+/// The wrinkle-scale filter uses `WRINKLE_REFINE`·K regions' length scale: ℓ_w = ℓ_c/4, the
+/// size of a test function refined by two levels of subdivision.
+pub const WRINKLE_REFINE: usize = 16;
 
 impl PairOut {
     /// Overhead (%) from the summed step times.
@@ -368,6 +387,7 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
     let mut san_g = Sanity::new(&gm.positions, gm.topology().edges(), Vec::new(), None);
     let k_lp = out.k.max(1);
     let lp = LowPass::new(&setup.tracked_rest, LowPass::tau_for(&setup.tracked_rest, k_lp))?;
+    let lp_w = LowPass::new(&setup.tracked_rest, LowPass::tau_for(&setup.tracked_rest, WRINKLE_REFINE * k_lp))?;
     let n_fine = setup.tracked_rest.n_vertices();
     let masks: Vec<Vec<bool>> = o.subsets.iter().map(|s| vertex_mask(n_fine, s)).collect();
     out.subsets = vec![SubsetSeries::default(); masks.len()];
@@ -396,6 +416,8 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
         &frames_t,
         &["frame", "t", "dc_tracked", "dc_untracked", "a_d", "rms_d", "bend_J", "tug", "isect_tracked", "isect_guide"],
     )?;
+    // The frame rate of the recorded sequences (their USD time codes are frame numbers).
+    rec.scene(&SceneItem::FrameRate { fps: setup.fps })?;
     let total = (o.frames as u64) * setup.substeps as u64;
     // Weight of the rest-angle events last applied (`Setup::rest_events`).
     let mut rest_w = 0.0;
@@ -522,6 +544,10 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
             let lo = lp.apply(&d)?;
             let detail: Vec<Vec3> = d.iter().zip(&lo).map(|(a, b)| a - b).collect();
             out.lambda_eff_tracked.push(lp.wavelength(&detail));
+            let lo_w = lp_w.apply(&d)?;
+            let wr: Vec<Vec3> = d.iter().zip(&lo_w).map(|(a, b)| a - b).collect();
+            out.ad_wrinkle_tracked.push(lp_w.rms(&wr));
+            out.lambda_wrinkle_tracked.push(lp_w.wavelength(&wr));
         }
         out.bend_tracked.push(bend);
         out.tug_tracked.push(tug);
@@ -589,7 +615,7 @@ pub fn run_standard_with(
     let o = PairOpts {
         frames,
         obj_every: p.obj_every,
-        untracked: true,
+        untracked: p.untracked,
         track: p.track(),
         intersections,
         anchors: None,

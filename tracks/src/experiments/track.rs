@@ -5,7 +5,8 @@
 //! connectivity is that of the guide subdivided `levels` times (its rest positions may differ:
 //! smoothed, crinkled); the test functions are the subdivision basis, an animation-aware
 //! clustering (identical meshes) or boxes painted in rest space; material and effects are the
-//! `shells` ones. The fine cloth starts on the prolonged first guide frame and runs tracked beside
+//! `shells` ones. The fine cloth starts on the prolonged first guide frame with the prolonged
+//! guide velocity (Catmull–Rom at t = 0) and runs tracked beside
 //! its untracked twin (the common keys of [`PairOut::report`](super::protocol::PairOut::report)
 //! and issue 20's sanity checks).
 //!
@@ -228,6 +229,11 @@ pub fn setup(p: &Params, size: Size) -> Result<Setup> {
     let mut g0 = vec![Pt3::origin(); guide.n_vertices()];
     guide.sample(0.0, &mut g0);
     let initial = guide_on_tracked(Some(&pm), &g0);
+    // The guide's velocity at t = 0 (Catmull–Rom), prolonged: both twins start moving with it.
+    let mut gv = vec![Vec3::zeros(); guide.n_vertices()];
+    guide.sample_velocity(0.0, &mut gv);
+    let gv_pts: Vec<Pt3> = gv.iter().map(|v| Pt3::from(*v)).collect();
+    let v0: Vec<Vec3> = guide_on_tracked(Some(&pm), &gv_pts).iter().map(|p| p.coords).collect();
     let e = &p.effects;
     let sc = e.self_collision.get(size);
     let mut obstacles = e.obstacles.clone();
@@ -249,8 +255,11 @@ pub fn setup(p: &Params, size: Size) -> Result<Setup> {
     };
     effects.validate()?;
     let (f2, mat) = (fine.clone(), p.material.clone());
-    let desc =
-        move || ShellSceneDesc { initial: Some(initial.clone()), ..shell_desc(&f2, mat.clone(), effects.clone()) };
+    let desc = move || ShellSceneDesc {
+        initial: Some(initial.clone()),
+        initial_velocity: Some(v0.clone()),
+        ..shell_desc(&f2, mat.clone(), effects.clone())
+    };
     Ok(Setup {
         fps: guide.fps,
         guide,
