@@ -83,6 +83,9 @@ pub enum TrackedMesh {
     },
 }
 
+/// A rest-space box (min corner, max corner) (m).
+pub type RestBox = ((f64, f64, f64), (f64, f64, f64));
+
 /// The test-function design (spec §3.3).
 #[derive(Clone, Debug, Deserialize)]
 pub enum Design {
@@ -96,7 +99,7 @@ pub enum Design {
         seed: u64,
     },
     /// Regions painted as rest-space boxes on the guide, transferred to the fine mesh by P.
-    Boxes(Vec<((f64, f64, f64), (f64, f64, f64))>),
+    Boxes(Vec<RestBox>),
 }
 
 /// Effects of the fine cloth.
