@@ -32,6 +32,7 @@ pub mod procedural;
 pub mod rest_events;
 pub mod testfn;
 pub mod tracker;
+pub mod usd_guide;
 
 pub use capture::CapturedSystem;
 pub use cluster::{cluster, ClusterInit, ClusterMetric, ClusterOptions, Clustering};

@@ -91,6 +91,68 @@ impl LowPass {
     }
 }
 
+impl LowPass {
+    /// Area-weighted RMS norm over the vertices with `mask[i]`:
+    /// sqrt(Σ_{i∈S} a_i‖x_i‖² / Σ_{i∈S} a_i) (NaN for an empty subset).
+    pub fn rms_subset(&self, x: &[Vec3], mask: &[bool]) -> f64 {
+        let (mut num, mut tot) = (0.0, 0.0);
+        for ((v, a), &m) in x.iter().zip(&self.areas).zip(mask) {
+            if m {
+                num += a * v.norm_squared();
+                tot += a;
+            }
+        }
+        if tot > 0.0 {
+            (num / tot).sqrt()
+        } else {
+            f64::NAN
+        }
+    }
+
+    /// Detail wavelength of a field h restricted to the vertices with `mask[i]` (m):
+    /// λ = 2π sqrt(Σ_{i∈S} a_i‖h_i‖² / Σ_{ij∈E(S)} w_ij‖h_i − h_j‖²), the quotient of
+    /// [`LowPass::wavelength`] with both sums over the subset (the edge form of hᵀKh keeps only
+    /// the edges with both ends in S, so no jump is created at the subset's border). Equals
+    /// [`LowPass::wavelength`] for the full mask; infinite when the subset's h is constant.
+    pub fn wavelength_subset(&self, h: &[Vec3], mask: &[bool]) -> f64 {
+        let mut num = 0.0;
+        for ((v, a), &m) in h.iter().zip(&self.areas).zip(mask) {
+            if m {
+                num += a * v.norm_squared();
+            }
+        }
+        let mut den = 0.0;
+        for i in 0..self.k.nrows {
+            if !mask[i] {
+                continue;
+            }
+            let (cols, vals) = self.k.row(i);
+            for (&j, &kij) in cols.iter().zip(vals) {
+                let j = j as usize;
+                if j > i && mask[j] {
+                    den += -kij * (h[i] - h[j]).norm_squared();
+                }
+            }
+        }
+        if den <= 0.0 {
+            f64::INFINITY
+        } else {
+            std::f64::consts::TAU * (num / den).sqrt()
+        }
+    }
+}
+
+/// A vertex mask of length `n` with `true` at `vertices`.
+pub fn vertex_mask(n: usize, vertices: &[u32]) -> Vec<bool> {
+    let mut m = vec![false; n];
+    for &v in vertices {
+        if let Some(x) = m.get_mut(v as usize) {
+            *x = true;
+        }
+    }
+    m
+}
+
 /// d = q − q̄_f with q̄_f = P q̄ (or q̄ itself for identical meshes).
 pub fn guide_on_tracked(prolongation: Option<&Csr>, guide_q: &[Pt3]) -> Vec<Pt3> {
     match prolongation {
@@ -331,6 +393,30 @@ mod tests {
             m.positions.iter().map(|p| Vec3::new(0.0, 0.0, (std::f64::consts::TAU * p.x / lambda).sin())).collect();
         let w = lp.wavelength(&h);
         assert!((w - lambda).abs() < 0.02 * lambda, "λ_eff = {w}");
+    }
+
+    /// The subset forms: full mask = the whole-mesh figures (1e-12); on a grid whose left half
+    /// carries a sinusoid of wavelength 0.25 m and whose right half one of 1 m, each half's
+    /// wavelength is its own (5 %).
+    #[test]
+    fn subset_wavelength_and_rms() {
+        let m = grid(&GridSpec { quads: [160, 8], size: [4.0, 0.2], ..GridSpec::default() }).expect("grid");
+        let lp = LowPass::new(&m, 0.0).expect("lowpass");
+        let wave =
+            |x: f64| if x < 0.0 { (std::f64::consts::TAU * x / 0.25).sin() } else { (std::f64::consts::TAU * x).sin() };
+        let h: Vec<Vec3> = m.positions.iter().map(|p| Vec3::new(0.0, 0.0, wave(p.x))).collect();
+        let all = vec![true; h.len()];
+        assert!((lp.wavelength_subset(&h, &all) - lp.wavelength(&h)).abs() < 1e-12 * lp.wavelength(&h));
+        assert!((lp.rms_subset(&h, &all) - lp.rms(&h)).abs() < 1e-12);
+        let left: Vec<u32> = (0..h.len() as u32).filter(|&v| m.positions[v as usize].x < -0.01).collect();
+        let right: Vec<u32> = (0..h.len() as u32).filter(|&v| m.positions[v as usize].x > 0.01).collect();
+        let (wl, wr) = (
+            lp.wavelength_subset(&h, &vertex_mask(h.len(), &left)),
+            lp.wavelength_subset(&h, &vertex_mask(h.len(), &right)),
+        );
+        assert!((wl - 0.25).abs() < 0.05 * 0.25, "left λ = {wl}");
+        assert!((wr - 1.0).abs() < 0.05, "right λ = {wr}");
+        assert!(lp.rms_subset(&h, &vec![false; h.len()]).is_nan());
     }
 
     /// Kabsch: a rigid motion has zero residual (1e-12).

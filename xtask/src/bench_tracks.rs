@@ -4,19 +4,25 @@
 //!    ([`partition_study`]): deviation and wavelength of the deviation field against the time
 //!    per frame (`partitions.csv` and the four PNGs of the partition study).
 //! 2. The exact KKT methods (constraint-last LDLᵀ, AMD-regularised LDLᵀ, bordered-LLᵀ Schur) at
-//!    16, 64 and 256 regions on the same clip: KKT solve time per step, stored factor entries and
-//!    overhead against the multiplier rows 3K (`kkt_vs_regions.csv`,
-//!    `overhead_vs_constraints.png`, `solve_ms_vs_constraints.png`).
-//! 3. The box (collisions off): penalty stiffness k_p against the exact Lagrange multipliers —
+//!    r = 0 (no constraint: the untracked path), 16, 64, 256 (and 1024) regions on the same clip:
+//!    KKT solve time per step, stored factor entries and overhead against the multiplier rows 3K
+//!    (`kkt_vs_regions.csv`, `overhead_vs_constraints.png`, `solve_ms_vs_constraints.png`).
+//! 3. The tracked flag (spec §9 sweep 3): substeps × IPC Newton iteration caps ∈ {1, 3} against
+//!    a fine-step reference (32 substeps, ≤ 10 Newton iterations, Newton tolerance 1e-4 m/s;
+//!    quick: 16 substeps): mean vertex-RMS distance to the reference / L, D_c and a_d against
+//!    milliseconds per frame (`flag_steps.csv`, `flag_error_vs_ms.png`).
+//! 4. The box (collisions off): penalty stiffness k_p against the exact Lagrange multipliers —
 //!    largest pre-collision residual / L against KKT milliseconds per step
 //!    (`penalty_vs_lagrange.csv`, `penalty_vs_lagrange.png`).
 
 use geom_core::experiment::Report;
-use geom_core::record::{Cell, Recorder, Series};
+use geom_core::math::Pt3;
+use geom_core::record::{Cell, MemoryRecorder, Recorder, Series};
 use shells::ContactMethod;
 use tracks::experiments::fig6_partitions::{partition_keys, partition_study, record_partitions, PartitionRow, Solvers};
-use tracks::experiments::protocol::{run_pair, track_opts, PairOpts};
-use tracks::presets::{box_setup, frames_for, ShellOptions};
+use tracks::experiments::flag::PREVIEW_DURATION;
+use tracks::experiments::protocol::{run_pair, track_opts, PairOpts, PairOut};
+use tracks::presets::{box_setup, flag_design, flag_setup, frames_for, FlagDesign, ShellOptions};
 use tracks::KktMethod;
 
 use crate::error::Result;
@@ -32,7 +38,7 @@ fn shell() -> ShellOptions {
     ShellOptions { substeps: 4, self_collision: false, contact: CONTACT }
 }
 
-/// Runs the three sweeps (quick: 16/64/256 regions, 3 frames; KKT methods 3 frames; penalty
+/// Runs the four sweeps (quick: 16/64/256 regions, 3 frames; KKT methods 3 frames; flag 0.5 s; penalty
 /// 0.2 s with k_p 1e3, 1e5, 1e7. Default: 16 … 1024 regions, 1 s; KKT methods 0.5 s; penalty
 /// 0.2 s with k_p 1e3 … 1e8 — a penalty step costs ≈ 1 s on the box, the fill of ĈᵀĈ).
 pub fn run(ctx: &BenchCtx) -> Result<Summary> {
@@ -49,6 +55,7 @@ pub fn run(ctx: &BenchCtx) -> Result<Summary> {
     r.timing("s_per_frame_untracked", geom_core::stats::mean(&untracked));
     r.num("duration_s", duration);
     kkt_methods(ctx, &mut r, &mut rec)?;
+    flag_steps(ctx, &mut r, &mut rec)?;
     penalty_vs_lagrange(ctx, &mut r, &mut rec)?;
     rec.finish()?;
     Ok(Summary::from_report(&r))
@@ -69,14 +76,14 @@ fn series(plot: &str, label: &str, axes: (&str, &str), log: (bool, bool), points
 
 /// Sweep 2: KKT solve time, factor size and overhead per exact method and region count.
 fn kkt_methods(ctx: &BenchCtx, r: &mut Report, rec: &mut FileRecorder) -> Result<()> {
-    let duration = if ctx.quick { 0.1 } else { 0.5 };
-    let regions = [16usize, 64, 256];
+    let (duration, regions): (f64, &[usize]) =
+        if ctx.quick { (0.1, &[0, 16, 64, 256]) } else { (0.5, &[0, 16, 64, 256, 1024]) };
     let mut runs = FileRecorder::new(&ctx.out_dir.join("kkt_methods"))?;
     let mut all: Vec<(&str, Vec<PartitionRow>)> = Vec::new();
     for (name, m) in exact_methods() {
         let refine = u32::from(matches!(m, KktMethod::AmdRegularizedLdlt { .. }));
         let solvers = Solvers { kkt: m, kkt_large: m, large_from: usize::MAX, refine_steps: refine };
-        let rows = partition_study(&regions, duration, &shell(), &solvers, &mut runs)?;
+        let rows = partition_study(regions, duration, &shell(), &solvers, &mut runs)?;
         for row in &rows {
             let n = row.regions;
             r.timing(&format!("kkt_ms_per_step_{name}_r{n}"), 1e3 * row.solve_s_per_step);
@@ -115,7 +122,88 @@ fn kkt_methods(ctx: &BenchCtx, r: &mut Report, rec: &mut FileRecorder) -> Result
     Ok(())
 }
 
-/// Sweep 3: the box with penalty constraints (k_p) against the exact constraint-last LDLᵀ.
+/// One tracked flag run of sweep 3 (`substeps` per frame, IPC Newton capped at `newton`
+/// iterations, tolerance `tol` m/s); returns the run and its tracked positions per frame.
+fn flag_run(d: &FlagDesign, duration: f64, substeps: u32, newton: u32, tol: f64) -> Result<(PairOut, Vec<Vec<Pt3>>)> {
+    let setup = flag_setup(d, &ShellOptions { substeps, self_collision: true, contact: CONTACT })?.edited(Box::new(
+        move |desc| {
+            if let Some(c) = desc.effects.collision.as_mut() {
+                c.max_newton_iters = newton;
+                c.newton_tol = tol;
+            }
+        },
+    ));
+    let o = PairOpts {
+        frames: frames_for(duration, setup.fps),
+        obj_every: 1,
+        untracked: false,
+        track: track_opts(KktMethod::ConstraintLastLdlt, 0),
+        intersections: false,
+        anchors: None,
+        tag: String::new(),
+        subsets: Vec::new(),
+    };
+    let mut mem = MemoryRecorder::default();
+    let out = run_pair(&setup, &o, &mut mem)?;
+    let frames = mem.frames.remove("tracked").unwrap_or_default().into_iter().map(|f| f.2).collect();
+    Ok((out, frames))
+}
+
+/// Sweep 3 (spec §9): the tracked flag at substeps × Newton iterations ∈ {1, 3} against a
+/// fine-step reference: mean over frames of the vertex-RMS distance to the reference / L, the
+/// mean D_c and a_d, and milliseconds of step time per frame.
+fn flag_steps(ctx: &BenchCtx, r: &mut Report, rec: &mut FileRecorder) -> Result<()> {
+    let (duration, subs, ref_sub): (f64, &[u32], u32) =
+        if ctx.quick { (0.5, &[1, 4], 16) } else { (2.0, &[1, 2, 4, 8], 32) };
+    let design = flag_design(PREVIEW_DURATION, CONTACT)?;
+    let (ref_out, ref_q) = flag_run(&design, duration, ref_sub, 10, 1e-4)?;
+    let mean = geom_core::stats::mean;
+    let scale = ref_out.scale;
+    let header = ["substeps", "newton_iters", "ms_per_frame", "error_rms_over_L", "dc_mean", "ad_mean_m", "r_pre"];
+    rec.table("flag_steps", &header)?;
+    let row = |rec: &mut FileRecorder, s: u32, n: u32, o: &PairOut, err: f64| {
+        let cells = [s as f64, n as f64, 1e3 * o.s_per_frame_tracked(), err, mean(&o.dc_tracked), mean(&o.ad_tracked)];
+        let mut c: Vec<Cell> = cells.iter().map(|&x| Cell::from(x)).collect();
+        c.push(Cell::from(o.r_pre()));
+        rec.row("flag_steps", &c)
+    };
+    row(rec, ref_sub, 10, &ref_out, 0.0)?;
+    r.timing("flag_ms_per_frame_reference", 1e3 * ref_out.s_per_frame_tracked());
+    r.num("flag_dc_mean_reference", mean(&ref_out.dc_tracked));
+    r.num("flag_ad_mean_m_reference", mean(&ref_out.ad_tracked));
+    let mut pts: Vec<(u32, Vec<(f64, f64)>)> = vec![(1, Vec::new()), (3, Vec::new())];
+    for &s in subs {
+        for (n, line) in pts.iter_mut() {
+            let (o, q) = flag_run(&design, duration, s, *n, 1e-2)?;
+            // Frames ≥ 1 of both runs (frame 0 is the shared initial state).
+            let errs: Vec<f64> = q
+                .iter()
+                .zip(&ref_q)
+                .skip(1)
+                .map(|(a, b)| {
+                    let ss: f64 = a.iter().zip(b).map(|(x, y)| (x - y).norm_squared()).sum();
+                    (ss / a.len().max(1) as f64).sqrt() / scale
+                })
+                .collect();
+            let err = mean(&errs);
+            row(rec, s, *n, &o, err)?;
+            let key = format!("s{s}_n{n}");
+            r.num(&format!("flag_error_{key}"), err);
+            r.timing(&format!("flag_ms_per_frame_{key}"), 1e3 * o.s_per_frame_tracked());
+            r.num(&format!("flag_dc_mean_{key}"), mean(&o.dc_tracked));
+            r.num(&format!("flag_ad_mean_m_{key}"), mean(&o.ad_tracked));
+            r.num(&format!("flag_max_residual_pre_{key}"), o.r_pre());
+            line.push((1e3 * o.s_per_frame_tracked(), err.max(1e-12)));
+        }
+    }
+    for (n, line) in pts {
+        let axes = ("ms per frame (tracked)", "RMS distance to the reference / L");
+        rec.series(&series("flag_error_vs_ms", &format!("≤ {n} Newton iterations"), axes, (true, true), line))?;
+    }
+    Ok(())
+}
+
+/// Sweep 4: the box with penalty constraints (k_p) against the exact constraint-last LDLᵀ.
 fn penalty_vs_lagrange(ctx: &BenchCtx, r: &mut Report, rec: &mut FileRecorder) -> Result<()> {
     let (duration, ks): (f64, &[f64]) =
         if ctx.quick { (0.2, &[1e3, 1e5, 1e7]) } else { (0.2, &[1e3, 1e4, 1e5, 1e6, 1e7, 1e8]) };
@@ -135,6 +223,7 @@ fn penalty_vs_lagrange(ctx: &BenchCtx, r: &mut Report, rec: &mut FileRecorder) -
             intersections: false,
             anchors: None,
             tag: format!("_{name}"),
+            subsets: Vec::new(),
         };
         let out = run_pair(&setup, &o, &mut runs)?;
         let ms = 1e3 * out.solve_s_per_step();

@@ -102,6 +102,7 @@ pub fn averaged_vs_pointwise(
         intersections: false,
         anchors: Some(anchors.clone()),
         tag: tag.to_string(),
+        subsets: Vec::new(),
     };
     let avg = run_pair(&make(avg_tf, avg_guide), &mk("_averaged", true), rec)?;
     let pw = run_pair(&make(pw_tf, pw_guide), &mk("_pointwise", false), rec)?;

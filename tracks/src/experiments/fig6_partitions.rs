@@ -30,6 +30,7 @@ use crate::error::Result;
 use crate::kkt::KktMethod;
 use crate::presets::{frames_for, xavier_setup, xavier_uniform_tf, ShellOptions, XAVIER_DURATION};
 use crate::procedural::{xavier, xavier_guide};
+use crate::testfn::TestFunctions;
 
 /// Parameters of `tracks/fig6-partitions` (the RON `params` block).
 #[derive(Clone, Debug, Deserialize)]
@@ -99,7 +100,8 @@ pub struct PartitionRow {
 }
 
 /// Runs the Xavier clip (tracked and untracked in lockstep, `duration` s) with a uniform
-/// clustering of each size in `regions` (tables and sequences tagged `_r<r>`).
+/// clustering of each size in `regions` (tables and sequences tagged `_r<r>`; r = 0 runs with no
+/// test function, the tracker's untracked path).
 pub fn partition_study(
     regions: &[usize],
     duration: f64,
@@ -111,7 +113,12 @@ pub fn partition_study(
     let guide = xavier_guide(&x, XAVIER_DURATION)?;
     let mut rows = Vec::new();
     for &r in regions {
-        let (tf, clustering_s) = xavier_uniform_tf(&x, &guide, r)?;
+        // r = 0: no test function (K = 0), the tracker takes the untracked path (spec §8).
+        let (tf, clustering_s) = if r == 0 {
+            (TestFunctions::from_labels(&vec![geom_core::NONE; x.mesh.n_vertices()], 0), 0.0)
+        } else {
+            xavier_uniform_tf(&x, &guide, r)?
+        };
         let k = tf.len();
         let setup = xavier_setup(&x, &guide, tf, shell);
         let kkt = if r >= solvers.large_from { solvers.kkt_large } else { solvers.kkt };
@@ -123,6 +130,7 @@ pub fn partition_study(
             intersections: false,
             anchors: None,
             tag: format!("_r{r}"),
+            subsets: Vec::new(),
         };
         let out = run_pair(&setup, &po, rec)?;
         rows.push(PartitionRow {

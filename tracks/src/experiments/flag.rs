@@ -6,7 +6,15 @@
 //! Keys (besides the common ones of [`PairOut::report`](super::protocol::PairOut::report)):
 //! `deviation_ratio_untracked_over_tracked` (D_c at the end), `deviation_ratio_mean`,
 //! `stuck_preview`, `stuck_previews_of_20`, `preview_total_s`, `preview_vx/vy`,
-//! `tracked_branch_distance_end_m`, `untracked_branch_distance_end_m`, `detail_amplitude_end_m`.
+//! `tracked_branch_distance_end_m`, `untracked_branch_distance_end_m`, `detail_amplitude_end_m`;
+//! the design loop's outcome as flags (spec §6.1: stuck yes/no for the preview, the untracked
+//! and the tracked fine run, expected yes / usually no / yes): `stuck_preview_found` (a preview
+//! of the 20 ended stuck on the branch), `tracked_stuck`, `untracked_stuck` (the fine runs by
+//! the same test, [`stuck_on_branch`]: centroid within 0.3 m of the branch axis, mean speed
+//! < 0.05 m/s over the last 0.5 s), `tracked_speed_last_0_5s_m_per_s`,
+//! `untracked_speed_last_0_5s_m_per_s` (mean vertex speed) and
+//! `{tracked,untracked}_centroid_speed_last_0_5s_m_per_s` (the centroid's own speed). Sequence
+//! `design_preview`: the chosen coarse preview at every frame.
 //!
 //! ```no_run
 //! use geom_core::experiment::Size;
@@ -24,8 +32,8 @@ use geom_core::record::Recorder;
 
 use super::protocol::{check_residual, check_sanity, run_standard, PairParams};
 use crate::error::Result;
-use crate::metrics::{branch_distance, centroid};
-use crate::presets::{flag_design, flag_setup};
+use crate::metrics::{branch_distance, centroid, stuck_on_branch};
+use crate::presets::{flag_design, flag_setup, FLAG_FPS};
 
 /// The flag's parameters (the RON `params` block).
 pub type Params = PairParams;
@@ -48,6 +56,20 @@ pub fn preview_duration(size: Size) -> f64 {
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     p.validate("tracks/flag")?;
     let design = flag_design(preview_duration(size), p.contact)?;
+    // The chosen preview itself, every frame (sequence `design_preview`: its OBJ frames and
+    // `design_preview.usda` are the guide file a user would export from the preview tool; the
+    // built-in `tracks/own-guide` reads it back).
+    let g = &design.guide;
+    for (k, q) in g.frames.iter().enumerate() {
+        rec.frame(&geom_core::record::MeshFrame {
+            sequence: "design_preview",
+            index: k,
+            time: k as f64 / g.fps,
+            positions: q,
+            faces: &g.rest.faces,
+            attributes: &[],
+        })?;
+    }
     let setup = flag_setup(&design, &p.shell(size))?;
     let (out, mut r) = run_standard(p, size, &setup, false, rec)?;
     let last = |v: &[f64]| v.last().copied().unwrap_or(f64::NAN);
@@ -61,11 +83,38 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     r.num("tracked_branch_distance_end_m", branch_distance(&centroid(&out.final_tracked)));
     r.num("untracked_branch_distance_end_m", branch_distance(&centroid(&out.final_untracked)));
     r.num("detail_amplitude_end_m", last(&out.ad_tracked));
+    let found = design.stuck_flags.iter().any(|&x| x);
+    let tracked_stuck = stuck_on_branch(&out.centroid_tracked, &out.speed_tracked, FLAG_FPS);
+    let untracked_stuck = stuck_on_branch(&out.centroid_untracked, &out.speed_untracked, FLAG_FPS);
+    r.flag("stuck_preview_found", found);
+    r.flag("tracked_stuck", tracked_stuck);
+    r.flag("untracked_stuck", untracked_stuck);
+    let tail_speed = |v: &[f64]| {
+        let n = ((0.5 * FLAG_FPS).round() as usize).min(v.len());
+        geom_core::stats::mean(&v[v.len() - n..])
+    };
+    r.num("tracked_speed_last_0_5s_m_per_s", tail_speed(&out.speed_tracked));
+    r.num("untracked_speed_last_0_5s_m_per_s", tail_speed(&out.speed_untracked));
+    // The centroid's own speed (the rigid drift of the whole cloth, without its inner motion).
+    let centroid_speed = |c: &[geom_core::math::Pt3]| {
+        let v: Vec<f64> = c.windows(2).map(|w| (w[1] - w[0]).norm() * FLAG_FPS).collect();
+        tail_speed(&v)
+    };
+    r.num("tracked_centroid_speed_last_0_5s_m_per_s", centroid_speed(&out.centroid_tracked));
+    r.num("untracked_centroid_speed_last_0_5s_m_per_s", centroid_speed(&out.centroid_untracked));
     r.check(
         "deviation_ratio_untracked_over_tracked",
         Target::AtLeast(3.0),
         "Bergou et al. 2007 §5.1: the tracked flag follows the preview (untracked D_c ≥ 3× tracked)",
     );
+    // The design loop's claim needs the whole 4 s clip: the previews of the tiny run last 0.5 s
+    // and its fine runs 0.07 s, so nothing can be on the branch yet.
+    if p.duration.get(size) >= PREVIEW_DURATION {
+        let src = "Bergou et al. 2007 §5.1 (spec §6.1): the design loop finds a preview stuck on the branch, \
+                   and the tracked fine flag sticks with it";
+        r.check("stuck_preview_found", Target::IsTrue, src);
+        r.check("tracked_stuck", Target::IsTrue, src);
+    }
     check_residual(&mut r, "max_residual_pre");
     check_sanity(&mut r);
     Ok(r)

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use geom_core::experiment::{BySize, Report, Size};
 use geom_core::math::{Pt3, Vec3};
-use geom_core::record::{Cell, MeshFrame, Recorder, Series};
+use geom_core::record::{Cell, MeshFrame, Recorder, SceneItem, Series};
 use serde::Deserialize;
 use shells::metrics::Sanity;
 use shells::{ContactMethod, ShellSim};
@@ -20,7 +20,8 @@ use shells::{ContactMethod, ShellSim};
 use crate::error::Result;
 use crate::kkt::KktMethod;
 use crate::metrics::{
-    guide_on_tracked, hinge_energies, kkt_over_untracked_factor, overhead_pct, overhead_pct_median, tug_index, LowPass,
+    centroid, guide_on_tracked, hinge_energies, kkt_over_untracked_factor, mean_speed, overhead_pct,
+    overhead_pct_median, tug_index, vertex_mask, LowPass,
 };
 use crate::presets::{frames_for, Setup, ShellOptions};
 use crate::tracker::{TrackOptions, Tracker};
@@ -45,6 +46,15 @@ pub struct PairParams {
     /// The contact model of the fine shell (default IPC; `Bridson` = the seed's filter).
     #[serde(default)]
     pub contact: ContactMethod,
+    /// Also run the untracked twin (default true). Off, the untracked keys are absent (NaN
+    /// deviations): for tracked-only figures when the twin's cost does not fit (a crumpled
+    /// untracked Xavier costs 1.4–6.6 s per step on the ground).
+    #[serde(default = "yes")]
+    pub untracked: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl PairParams {
@@ -126,6 +136,22 @@ pub struct PairOpts {
     pub anchors: Option<Vec<u32>>,
     /// Suffix of the table and sequence names (`""`, `"_averaged"`, `"_r16"` …).
     pub tag: String,
+    /// Vertex subsets of the tracked mesh whose figures are also measured on their own
+    /// ([`PairOut::subsets`]; e.g. Xavier's feet and body, the two halves of Fig. 5).
+    pub subsets: Vec<Vec<u32>>,
+}
+
+/// Per-frame figures of one vertex subset of the tracked run (frames ≥ 1).
+#[derive(Clone, Debug, Default)]
+pub struct SubsetSeries {
+    /// D_c restricted to the subset: area-RMS over its vertices of (L_τ d)_i, / L.
+    pub dc: Vec<f64>,
+    /// a_d restricted to the subset: area-RMS over its vertices of (d − L_τ d)_i (m).
+    pub ad: Vec<f64>,
+    /// Area-RMS ‖d‖ / L over the subset.
+    pub rms: Vec<f64>,
+    /// λ_eff of d itself restricted to the subset ([`LowPass::wavelength_subset`], m).
+    pub lambda_raw: Vec<f64>,
 }
 
 /// Figures of one lockstep run.
@@ -213,7 +239,27 @@ pub struct PairOut {
     /// Exact self-intersection count, max over the counted frames (every frame with
     /// `intersections`, otherwise every recorded frame and the last one), tracked / untracked.
     pub max_intersections: (u64, u64),
+    /// Per frame ≥ 1: centroid of the tracked cloth (m).
+    pub centroid_tracked: Vec<Pt3>,
+    /// Per frame ≥ 1: mean vertex speed of the tracked cloth (m/s).
+    pub speed_tracked: Vec<f64>,
+    /// Per frame ≥ 1: centroid of the untracked cloth (m; empty without the twin).
+    pub centroid_untracked: Vec<Pt3>,
+    /// Per frame ≥ 1: mean vertex speed of the untracked cloth (m/s; empty without the twin).
+    pub speed_untracked: Vec<f64>,
+    /// Per subset of [`PairOpts::subsets`]: its per-frame figures.
+    pub subsets: Vec<SubsetSeries>,
+    /// Per frame ≥ 1: wrinkle-scale detail amplitude of the tracked run (m): a_d with the
+    /// filter scale ℓ_w = ℓ_c/4 ([`WRINKLE_REFINE`]: detail finer than the test functions
+    /// refined twice), so box-scale departures from the guide count as coarse.
+    pub ad_wrinkle_tracked: Vec<f64>,
+    /// Per frame ≥ 1: λ_eff of the wrinkle-scale detail (m).
+    pub lambda_wrinkle_tracked: Vec<f64>,
 }
+
+/// The wrinkle-scale filter uses `WRINKLE_REFINE`·K regions' length scale: ℓ_w = ℓ_c/4, the
+/// size of a test function refined by two levels of subdivision.
+pub const WRINKLE_REFINE: usize = 16;
 
 impl PairOut {
     /// Overhead (%) from the summed step times.
@@ -365,6 +411,10 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
     let mut san_g = Sanity::new(&gm.positions, gm.topology().edges(), Vec::new(), None);
     let k_lp = out.k.max(1);
     let lp = LowPass::new(&setup.tracked_rest, LowPass::tau_for(&setup.tracked_rest, k_lp))?;
+    let lp_w = LowPass::new(&setup.tracked_rest, LowPass::tau_for(&setup.tracked_rest, WRINKLE_REFINE * k_lp))?;
+    let n_fine = setup.tracked_rest.n_vertices();
+    let masks: Vec<Vec<bool>> = o.subsets.iter().map(|s| vertex_mask(n_fine, s)).collect();
+    out.subsets = vec![SubsetSeries::default(); masks.len()];
     let h = setup.h();
     let faces = tr.sim.mesh().tris.clone();
     let mut gq = vec![Pt3::origin(); setup.guide.n_vertices()];
@@ -393,6 +443,8 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
         &frames_t,
         &["frame", "t", "dc_tracked", "dc_untracked", "a_d", "rms_d", "bend_J", "tug", "isect_tracked", "isect_guide"],
     )?;
+    // The frame rate of the recorded sequences (their USD time codes are frame numbers).
+    rec.scene(&SceneItem::FrameRate { fps: setup.fps })?;
     let total = (o.frames as u64) * setup.substeps as u64;
     // Weight of the rest-angle events last applied (`Setup::rest_events`).
     let mut rest_w = 0.0;
@@ -501,6 +553,22 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
             }
         }
         if frame > 0 {
+            out.centroid_tracked.push(centroid(q));
+            out.speed_tracked.push(mean_speed(&tr.sim.state().v));
+            if let Some(u) = un.as_ref() {
+                out.centroid_untracked.push(centroid(&u.state().q));
+                out.speed_untracked.push(mean_speed(&u.state().v));
+            }
+            if !masks.is_empty() {
+                let lo = lp.apply(&d)?;
+                let hi: Vec<Vec3> = d.iter().zip(&lo).map(|(a, b)| a - b).collect();
+                for (m, ss) in masks.iter().zip(out.subsets.iter_mut()) {
+                    ss.dc.push(lp.rms_subset(&lo, m) / out.scale);
+                    ss.ad.push(lp.rms_subset(&hi, m));
+                    ss.rms.push(lp.rms_subset(&d, m) / out.scale);
+                    ss.lambda_raw.push(lp.wavelength_subset(&d, m));
+                }
+            }
             out.dc_tracked.push(dc);
             out.dc_untracked.push(dcu);
             out.ad_tracked.push(ad);
@@ -509,6 +577,10 @@ pub fn run_pair(setup: &Setup, o: &PairOpts, rec: &mut dyn Recorder) -> Result<P
             let lo = lp.apply(&d)?;
             let detail: Vec<Vec3> = d.iter().zip(&lo).map(|(a, b)| a - b).collect();
             out.lambda_eff_tracked.push(lp.wavelength(&detail));
+            let lo_w = lp_w.apply(&d)?;
+            let wr: Vec<Vec3> = d.iter().zip(&lo_w).map(|(a, b)| a - b).collect();
+            out.ad_wrinkle_tracked.push(lp_w.rms(&wr));
+            out.lambda_wrinkle_tracked.push(lp_w.wavelength(&wr));
         }
         out.bend_tracked.push(bend);
         out.tug_tracked.push(tug);
@@ -559,15 +631,29 @@ pub fn run_standard(
     intersections: bool,
     rec: &mut dyn Recorder,
 ) -> Result<(PairOut, Report)> {
+    run_standard_with(p, size, setup, intersections, Vec::new(), rec)
+}
+
+/// [`run_standard`] that also measures the figures of vertex `subsets` of the tracked mesh
+/// ([`PairOut::subsets`]).
+pub fn run_standard_with(
+    p: &PairParams,
+    size: Size,
+    setup: &Setup,
+    intersections: bool,
+    subsets: Vec<Vec<u32>>,
+    rec: &mut dyn Recorder,
+) -> Result<(PairOut, Report)> {
     let frames = frames_for(p.duration.get(size), setup.fps);
     let o = PairOpts {
         frames,
         obj_every: p.obj_every,
-        untracked: true,
+        untracked: p.untracked,
         track: p.track(),
         intersections,
         anchors: None,
         tag: String::new(),
+        subsets,
     };
     let out = run_pair(setup, &o, rec)?;
     out.record_deviation(rec)?;

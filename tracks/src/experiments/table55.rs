@@ -164,6 +164,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
                 intersections: false,
                 anchors: None,
                 tag: format!("_{name}_{rep}"),
+                subsets: Vec::new(),
             };
             let out = run_pair(setup, &o, rec)?;
             worst_pre = geom_core::stats::nan_max(worst_pre, out.r_pre());
@@ -286,6 +287,7 @@ fn compare_methods(
             intersections: false,
             anchors: None,
             tag: format!("_{name}_methods"),
+            subsets: Vec::new(),
         };
         let out = run_pair(setup, &o, rec)?;
         let steps = out.steps.max(1) as f64;

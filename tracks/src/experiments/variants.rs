@@ -98,6 +98,7 @@ pub fn run_variants(
             intersections,
             anchors: None,
             tag: format!("_{}", v.name),
+            subsets: Vec::new(),
         };
         let k_b = (setup.desc)().material.bending;
         let out = run_pair(&setup, &o, rec)?;

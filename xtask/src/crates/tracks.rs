@@ -3,8 +3,8 @@
 //! outputs through the file recorder, `summary.json` and `checks.json` from its report).
 
 use tracks::experiments::{
-    bag, bag_variants, box_twist, box_variants, fig3_band, fig4_sphere, fig6_partitions, fig7_clustering, flag,
-    table55, xavier,
+    bag, bag_variants, box_twist, box_variants, fig3_band, fig4_sphere, fig5_heterogeneous, fig6_partitions,
+    fig7_clustering, flag, table55, track, xavier,
 };
 use tracks::TrackError;
 
@@ -29,11 +29,22 @@ pub fn register(v: &mut Vec<Runner>) {
     v.push(Runner { method: "tracks/xavier", run: |c| run_experiment(c, xavier::run) });
     v.push(Runner { method: "tracks/fig3-band", run: |c| run_experiment(c, fig3_band::run) });
     v.push(Runner { method: "tracks/fig4-sphere", run: |c| run_experiment(c, fig4_sphere::run) });
+    v.push(Runner { method: "tracks/fig5-heterogeneous", run: |c| run_experiment(c, fig5_heterogeneous::run) });
     v.push(Runner { method: "tracks/fig6-partitions", run: |c| run_experiment(c, fig6_partitions::run) });
     v.push(Runner { method: "tracks/fig7-clustering", run: |c| run_experiment(c, fig7_clustering::run) });
+    v.push(Runner { method: "tracks/track", run: run_track });
     v.push(Runner { method: "tracks/table55", run: |c| run_experiment(c, table55::run) });
     v.push(Runner { method: "tracks/box-variants", run: |c| run_experiment(c, box_variants::run) });
     v.push(Runner { method: "tracks/bag-variants", run: |c| run_experiment(c, bag_variants::run) });
+}
+
+/// A user's own guide: the guide and tracked-mesh paths are relative to the scene file.
+fn run_track(ctx: &crate::registry::RunCtx) -> crate::error::Result<crate::out::Summary> {
+    run_experiment(ctx, |p: &track::Params, size, rec| {
+        let mut p = p.clone();
+        p.resolve_paths(&ctx.resolve("."));
+        track::run(&p, size, rec)
+    })
 }
 
 #[cfg(test)]
@@ -54,9 +65,13 @@ mod tests {
         }
         scene::load::<tracks::experiments::anchors::AnchorParams>(&load("fig3-band")).expect("fig3");
         scene::load::<tracks::experiments::anchors::AnchorParams>(&load("fig4-sphere")).expect("fig4");
+        let f5 =
+            scene::load::<tracks::experiments::fig5_heterogeneous::Params>(&load("fig5-heterogeneous")).expect("fig5");
+        f5.params.validate().expect("valid fig5");
         scene::load::<tracks::experiments::fig6_partitions::Params>(&load("fig6-partitions")).expect("fig6");
         scene::load::<tracks::experiments::fig7_clustering::Params>(&load("fig7-clustering")).expect("fig7");
         scene::load::<tracks::experiments::table55::Params>(&load("table55")).expect("table55");
+        scene::load::<tracks::experiments::track::Params>(&load("own-guide")).expect("own-guide");
         let bx = scene::load::<tracks::experiments::box_variants::Params>(&load("box-variants")).expect("box-v");
         bx.params.validate().expect("valid box variants");
         let bg = scene::load::<tracks::experiments::bag_variants::Params>(&load("bag-variants")).expect("bag-v");
