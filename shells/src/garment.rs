@@ -125,7 +125,8 @@ mod tests {
 
     #[test]
     fn a_skirt_around_a_box_clears_it_and_hugs_the_waist() {
-        let b = box_surface(Pt3::new(-0.1, 0.0, -0.1), Pt3::new(0.1, 1.0, 0.1), [4, 8, 4], Diagonals::Alternating).unwrap();
+        let b =
+            box_surface(Pt3::new(-0.1, 0.0, -0.1), Pt3::new(0.1, 1.0, 0.1), [4, 8, 4], Diagonals::Alternating).unwrap();
         let s = SkirtSpec {
             waist_y: 0.9,
             hem_y: 0.4,

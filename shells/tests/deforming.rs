@@ -13,7 +13,8 @@ const H: f64 = 1.0 / 120.0;
 
 /// A 0.4 m box (top at y = 0) whose frames at 120 fps follow `f(t, rest vertex)`.
 fn box_frames(steps: usize, f: impl Fn(f64, &Pt3) -> Pt3) -> (Vec<[u32; 3]>, Vec<Vec<Pt3>>) {
-    let m = box_surface(Pt3::new(-0.2, -0.3, -0.2), Pt3::new(0.2, 0.0, 0.2), [4, 3, 4], Diagonals::Alternating).unwrap();
+    let m =
+        box_surface(Pt3::new(-0.2, -0.3, -0.2), Pt3::new(0.2, 0.0, 0.2), [4, 3, 4], Diagonals::Alternating).unwrap();
     let frames = (0..=steps).map(|k| m.positions.iter().map(|p| f(k as f64 * H, p)).collect()).collect();
     (m.faces.clone(), frames)
 }

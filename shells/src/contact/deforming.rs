@@ -63,7 +63,8 @@ impl DeformingMesh {
         if !(friction >= 0.0) || !friction.is_finite() {
             return bad(format!("friction must be finite and ≥ 0, got {friction}"));
         }
-        let m = TriMesh::new(first.clone(), tris.clone()).map_err(|e| Error::BadParameter(format!("deforming obstacle: {e}")))?;
+        let m = TriMesh::new(first.clone(), tris.clone())
+            .map_err(|e| Error::BadParameter(format!("deforming obstacle: {e}")))?;
         if m.faces.is_empty() || !m.topology().is_closed() {
             return bad(format!(
                 "the mesh is not closed ({} boundary edges, {} faces): it has no inside",
@@ -119,7 +120,14 @@ impl DeformingMesh {
 /// over a step, with activation distance `dhat` (m): each vertex within d̂ + 2D of the surface
 /// at `p0` (D the largest obstacle displacement) gets the displacement of its closest surface
 /// point, weighted 1 up to d̂ + D and fading linearly to 0 at d̂ + 2D; added to `out`.
-pub(crate) fn add_carry(tris: &[[u32; 3]], p0: &[Pt3], p1: &[Pt3], x: &[Pt3], dhat: f64, out: &mut [Vec3]) -> Result<()> {
+pub(crate) fn add_carry(
+    tris: &[[u32; 3]],
+    p0: &[Pt3],
+    p1: &[Pt3],
+    x: &[Pt3],
+    dhat: f64,
+    out: &mut [Vec3],
+) -> Result<()> {
     let disp: Vec<Vec3> = p0.iter().zip(p1).map(|(a, b)| b - a).collect();
     let dmax = disp.iter().map(|d| d.norm()).fold(0.0, f64::max);
     if !(dmax > 0.0) {
@@ -149,4 +157,76 @@ pub(crate) fn add_carry(tris: &[[u32; 3]], p0: &[Pt3], p1: &[Pt3], x: &[Pt3], dh
         *o += c;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::obstacle::{mesh_edges, Core, Placed};
+    use super::super::set::{self, CoreCands, Topo};
+    use super::*;
+    use geom_core::procedural::{box_surface, Diagonals};
+
+    /// A triangle in the plane y = `y0` moving to y = `y1` over the step.
+    fn rising(y0: f64, y1: f64) -> Placed {
+        let at = |y: f64| vec![Pt3::new(-1.0, y, -1.0), Pt3::new(2.0, y, -1.0), Pt3::new(-1.0, y, 2.0)];
+        Placed::Core(Box::new(Core::moving(&at(y0), at(y1), mesh_edges(&[[0, 1, 2]]), vec![[0, 1, 2]])))
+    }
+
+    #[test]
+    fn ccd_against_a_moving_triangle_uses_the_relative_motion() {
+        let p = rising(0.0, 2.0);
+        let c = CoreCands { v_ot: vec![(0, 0)], ..Default::default() };
+        let x = [Pt3::new(0.2, 1.0, 0.2)];
+        let toi = |dx: Vec3, relative: bool| super::super::obstacle_toi(&p, &c, &x, &[dx], &[], &[], 1e-9, relative);
+        // Gap 1 m closing at 2 m per step; the CCD stops at 10 % of the gap: t* = 0.45.
+        let a = toi(Vec3::zeros(), true);
+        assert!(a <= 0.45 && a > 0.44, "{a}");
+        // Falling at 1 m per step toward it: closing at 3, t* = 0.3.
+        let a = toi(Vec3::new(0.0, -1.0, 0.0), true);
+        assert!(a <= 0.3 && a > 0.29, "{a}");
+        // Carried with it: no relative motion, no bound.
+        assert_eq!(toi(Vec3::new(0.0, 2.0, 0.0), true), 1.0);
+        // The Newton phase: the triangle fixed at its end (y = 2), the still point 1 m below.
+        assert_eq!(toi(Vec3::zeros(), false), 1.0);
+    }
+
+    #[test]
+    fn barrier_distances_are_to_the_end_of_step_triangle() {
+        let p = rising(0.0, 0.5);
+        let c = CoreCands { v_ot: vec![(0, 0)], ..Default::default() };
+        let topo = Topo { tris: &[], edges: &[], mean_edge: 1.0, mu_self: 0.0 };
+        let x = [Pt3::new(0.2, 0.51, 0.2)];
+        let cs = set::obstacle_contacts(&topo, &x, 0, &p, &c, 0.3, 0.05);
+        assert_eq!(cs.len(), 1);
+        assert!((cs[0].gap(&x).d - 0.01).abs() < 1e-12, "{}", cs[0].gap(&x).d);
+        // 0.51 m above the start triangle: no contact there is considered.
+        assert!(set::obstacle_contacts(&topo, &[Pt3::new(0.2, 0.6, 0.2)], 0, &p, &c, 0.3, 0.05).is_empty());
+    }
+
+    #[test]
+    fn the_carry_moves_near_vertices_with_the_surface_and_leaves_far_ones() {
+        let b = box_surface(Pt3::new(-0.5, -1.0, -0.5), Pt3::new(0.5, 0.0, 0.5), [2, 2, 2], Diagonals::Alternating)
+            .unwrap();
+        let p1: Vec<Pt3> = b.positions.iter().map(|p| p + Vec3::new(0.0, 0.05, 0.0)).collect();
+        let x = [Pt3::new(0.1, 0.01, 0.1), Pt3::new(0.1, 0.08, 0.1), Pt3::new(0.1, 1.0, 0.1)];
+        let mut out = vec![Vec3::zeros(); 3];
+        add_carry(&b.faces, &b.positions, &p1, &x, 0.01, &mut out).unwrap();
+        // Within d̂ + D = 0.06: carried fully; at 0.08 (between 0.06 and 0.11): 60 %; far: still.
+        assert!((out[0] - Vec3::new(0.0, 0.05, 0.0)).norm() < 1e-12, "{:?}", out[0]);
+        assert!((out[1] - Vec3::new(0.0, 0.03, 0.0)).norm() < 1e-12, "{:?}", out[1]);
+        assert_eq!(out[2], Vec3::zeros());
+    }
+
+    #[test]
+    fn frames_interpolate_linearly_and_hold_at_the_ends() {
+        let b = box_surface(Pt3::new(-0.5, -1.0, -0.5), Pt3::new(0.5, 0.0, 0.5), [1, 1, 1], Diagonals::Alternating)
+            .unwrap();
+        let up: Vec<Pt3> = b.positions.iter().map(|p| p + Vec3::new(0.0, 1.0, 0.0)).collect();
+        let d = DeformingMesh::new(b.faces.clone(), vec![b.positions.clone(), up], 1.0, 10.0, 0.2).unwrap();
+        assert!((d.positions(1.05)[0].y - (b.positions[0].y + 0.5)).abs() < 1e-12);
+        assert_eq!(d.positions(0.0)[0], b.positions[0]);
+        assert_eq!(d.positions(9.0)[0].y, b.positions[0].y + 1.0);
+        assert_eq!(d.max_penetration(0.0, &[Pt3::new(0.0, -0.25, 0.0)]).unwrap(), 0.25);
+        assert!(d.max_penetration(0.0, &[Pt3::new(f64::NAN, 0.0, 0.0)]).unwrap().is_nan());
+    }
 }

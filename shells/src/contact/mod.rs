@@ -531,7 +531,8 @@ fn obstacle_toi(
             let z = Vec3::zeros();
             let moving = relative && !core.disp.is_empty();
             // The obstacle's points at the motion's start and their displacements.
-            let pt = |i: u32| if moving { core.points[i as usize] - core.disp[i as usize] } else { core.points[i as usize] };
+            let pt =
+                |i: u32| if moving { core.points[i as usize] - core.disp[i as usize] } else { core.points[i as usize] };
             let od = |i: u32| if moving { core.disp[i as usize] } else { z };
             let mut alpha: f64 = 1.0;
             for &(v, t) in &c.v_ot {
