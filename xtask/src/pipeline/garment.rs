@@ -134,32 +134,86 @@ pub fn build(src: &GarmentSource, c: &Character, gap: f64, resolve: impl Fn(&Pat
     Ok(g)
 }
 
-/// Skinning weights of the garment's vertices: each takes the weights of its nearest body
-/// point (the barycentric blend of that triangle's vertices' rows), the 4 largest kept and
-/// renormalised.
-pub fn transfer_weights(c: &Character, garment: &TriMesh) -> Result<Vec<Vec<(u16, f32)>>> {
+/// Coarse skinning weights of the garment's vertices: each takes the weights of its nearest
+/// body point (the barycentric blend of that triangle's vertices' rows), then the rows of the
+/// free vertices are smoothed over the garment; the 4 largest are kept and renormalised.
+pub fn transfer_weights(c: &Character, garment: &TriMesh, attached: &[u32]) -> Result<Vec<Vec<(u16, f32)>>> {
     let q = MeshQuery::new(&c.mesh)?;
     let rows = super::body::weight_rows(&c.weights);
-    Ok(garment
+    let nj = c.skeleton.len();
+    // Dense rows: the nearest body point's weights (barycentric blend of its triangle's rows).
+    let mut w: Vec<Vec<f32>> = garment
         .positions
         .iter()
         .map(|p| {
             let cl = q.closest(p);
             let t = c.mesh.faces[cl.face as usize];
-            let mut acc: Vec<(u16, f32)> = Vec::new();
+            let mut row = vec![0f32; nj];
             for k in 0..3 {
-                for &(j, w) in &rows[t[k] as usize] {
-                    let w = w * cl.bary[k] as f32;
-                    match acc.iter_mut().find(|e| e.0 == j) {
-                        Some(e) => e.1 += w,
-                        None => acc.push((j, w)),
-                    }
+                for &(j, x) in &rows[t[k] as usize] {
+                    row[j as usize] += x * cl.bary[k] as f32;
                 }
             }
+            row
+        })
+        .collect();
+    // Coarse: smoothed over the garment (neighbour averaging, `SMOOTH` passes), so that one
+    // ring does not split between the two thighs; attached vertices keep their own rows.
+    const SMOOTH: usize = 40;
+    let edges = garment.topology().edges().to_vec();
+    let fixed: std::collections::HashSet<u32> = attached.iter().copied().collect();
+    for _ in 0..SMOOTH {
+        let mut acc = vec![vec![0f32; nj]; w.len()];
+        let mut deg = vec![0f32; w.len()];
+        for e in &edges {
+            for (a, b) in [(e[0], e[1]), (e[1], e[0])] {
+                for j in 0..nj {
+                    acc[a as usize][j] += w[b as usize][j];
+                }
+                deg[a as usize] += 1.0;
+            }
+        }
+        for (v, row) in w.iter_mut().enumerate() {
+            if deg[v] > 0.0 && !fixed.contains(&(v as u32)) {
+                for j in 0..nj {
+                    row[j] = 0.5 * row[j] + 0.5 * acc[v][j] / deg[v];
+                }
+            }
+        }
+    }
+    Ok(w.iter()
+        .map(|row| {
+            let mut acc: Vec<(u16, f32)> =
+                row.iter().enumerate().filter(|e| *e.1 > 0.0).map(|(j, &x)| (j as u16, x)).collect();
             acc.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
             acc.truncate(4);
             let s: f32 = acc.iter().map(|e| e.1).sum();
             acc.iter().map(|&(j, w)| (j, w / s)).collect()
         })
         .collect())
+}
+
+/// Moves the attached vertices of every guide frame onto the body: each keeps the point of the
+/// body surface nearest to it at rest (its triangle and barycentric coordinates) and its rest
+/// distance along that triangle's normal, so the waistband rides at its clearance on the
+/// deforming surface instead of being overtaken by it.
+pub fn attach_to_body(c: &Character, g: &Garment, body_frames: &[Vec<Pt3>], guide: &mut [Vec<Pt3>]) -> Result<()> {
+    let q = MeshQuery::new(&c.mesh)?;
+    let embed: Vec<(u32, [f64; 3], f64)> = g
+        .attached
+        .iter()
+        .map(|&v| {
+            let (cl, sd) = q.closest_signed(&g.mesh.positions[v as usize]);
+            (cl.face, cl.bary, sd)
+        })
+        .collect();
+    for (b, f) in body_frames.iter().zip(guide.iter_mut()) {
+        for (&v, &(face, w, d)) in g.attached.iter().zip(&embed) {
+            let t = c.mesh.faces[face as usize].map(|i| b[i as usize]);
+            let n = (t[1] - t[0]).cross(&(t[2] - t[0])).normalize();
+            let p = Pt3::from(w[0] * t[0].coords + w[1] * t[1].coords + w[2] * t[2].coords);
+            f[v as usize] = p + d * n;
+        }
+    }
+    Ok(())
 }

@@ -119,13 +119,15 @@ pub fn run(ctx: &RunCtx, p: &Params, size: Size, rec: &mut dyn Recorder) -> Resu
     let settle = p.settle.get(size);
     let poses = body::poses(&rt.motion, &c.skeleton.rest_pose(), p.clip_start, seconds, settle, p.fps);
     let mut body_skin = body::Skin::new(&c.skeleton, &c.mesh.positions, &body::weight_rows(&c.weights))?;
-    let mut garment_skin = body::Skin::new(&c.skeleton, &g.mesh.positions, &garment::transfer_weights(&c, &g.mesh)?)?;
+    let mut garment_skin =
+        body::Skin::new(&c.skeleton, &g.mesh.positions, &garment::transfer_weights(&c, &g.mesh, &g.attached)?)?;
     let mut body_frames = Vec::with_capacity(poses.len());
     let mut guide = Vec::with_capacity(poses.len());
     for pose in &poses {
         body_frames.push(body_skin.pose(pose)?);
         guide.push(garment_skin.pose(pose)?);
     }
+    garment::attach_to_body(&c, &g, &body_frames, &mut guide)?;
     r.timing("skin_s", t0.elapsed().as_secs_f64());
     let frames = poses.len();
     r.num("motion_s", (frames - 1) as f64 / p.fps).num("clip_motion_s", (frames - 1) as f64 / p.fps - settle);

@@ -202,7 +202,7 @@ fn state<'a>(tr: &'a Option<Tracker>, un: &'a Option<ShellSim>) -> &'a shells::S
     }
 }
 
-/// A step, retried as 2 and then 4 substeps (from the saved start state) when a moving body
+/// A step, retried as 2, 4, 8 and then 16 substeps (from the saved start state) when a moving body
 /// would enter the cloth within it.
 fn step_retry(sim: &mut ShellSim, h: f64) -> std::result::Result<(), String> {
     retry(sim, h, |s, h| s.step(h).map(|_| ()).map_err(|e| e.to_string()))
@@ -212,7 +212,7 @@ fn step_retry(sim: &mut ShellSim, h: f64) -> std::result::Result<(), String> {
 fn track_retry(tr: &mut Tracker, h: f64) -> std::result::Result<(), String> {
     let start = tr.sim.state().clone();
     let mut last = String::new();
-    for n in [1u32, 2, 4] {
+    for n in [1u32, 2, 4, 8, 16] {
         if n > 1 {
             tr.sim.set_state(start.clone()).map_err(|e| e.to_string())?;
         }
@@ -234,7 +234,7 @@ fn retry(
 ) -> std::result::Result<(), String> {
     let start = sim.state().clone();
     let mut last = String::new();
-    for n in [1u32, 2, 4] {
+    for n in [1u32, 2, 4, 8, 16] {
         if n > 1 {
             sim.set_state(start.clone()).map_err(|e| e.to_string())?;
         }
