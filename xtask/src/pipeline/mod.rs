@@ -189,6 +189,7 @@ pub fn run(ctx: &RunCtx, p: &Params, size: Size, rec: &mut dyn Recorder) -> Resu
         .count("max_intersections", un.max_intersections.max(tr.max_intersections))
         .num("max_edge_strain", worst(un.max_edge_strain, tr.max_edge_strain))
         .count("nan_steps", un.nan_steps + tr.nan_steps)
+        .flag("completed", un.failure.is_none() && tr.failure.is_none())
         .num("coarse_deviation_ratio", tr.coarse_deviation / un.coarse_deviation);
     checks(&mut r);
     Ok(r)
@@ -206,6 +207,11 @@ fn checks(r: &mut Report) {
         .check("max_intersections", Target::AtMost(0.0), src)
         .check("max_edge_strain", Target::AtMost(0.10), src)
         .check("nan_steps", Target::AtMost(0.0), src)
+        .check(
+            "completed",
+            Target::IsTrue,
+            "both garment runs reach the end (the figures cover only the frames before a failure)",
+        )
         .check("coarse_deviation_ratio", Target::AtMost(1.0 / 3.0), src);
 }
 
