@@ -26,6 +26,7 @@ pub mod contact;
 pub mod effects;
 pub mod error;
 pub mod experiments;
+pub mod garment;
 pub mod integrator;
 pub mod kernels;
 pub mod loads;
@@ -38,6 +39,7 @@ pub mod scene;
 pub mod sim;
 pub mod wind;
 
+pub use contact::deforming::DeformingMesh;
 pub use contact::ContactStats;
 pub use effects::{
     BlockTriplets, CollisionSettings, ContactMethod, Effects, ExternalForce, KinematicPath, Obstacle, ObstacleShape,

@@ -391,6 +391,29 @@ impl ShellSim {
         }
     }
 
+    /// Adds a deforming-mesh obstacle (a skinned body; `contact::deforming`): from the next step
+    /// on, the cloth collides with its moving triangles. Its obstacle index in contact reports
+    /// follows the rigid obstacles of the effects.
+    ///
+    /// Errors: `BadParameter` without IPC contact (`effects.collision` with the IPC method), or
+    /// when the cloth's current state lies inside the obstacle at the current time.
+    pub fn add_deforming_obstacle(&mut self, d: crate::contact::deforming::DeformingMesh) -> Result<()> {
+        let Some(ipc) = self.ipc.as_mut() else {
+            return Err(Error::BadParameter(
+                "deforming obstacles need IPC contact (effects.collision with method Ipc)".into(),
+            ));
+        };
+        let depth = d.max_penetration(self.state.t, &self.state.q)?;
+        if !(depth == 0.0) {
+            return Err(Error::BadParameter(format!(
+                "the cloth starts inside the deforming obstacle at t = {} s (depth {depth:.3e} m)",
+                self.state.t
+            )));
+        }
+        ipc.add_deforming(d);
+        Ok(())
+    }
+
     /// IPC's activation distance d̂ and current barrier stiffness κ (`None` without IPC).
     pub fn barrier_parameters(&self) -> Option<(f64, f64)> {
         self.ipc.as_ref().map(|i| (i.dhat, i.kappa))
@@ -667,9 +690,10 @@ impl ShellSim {
         st: &mut StepStats,
     ) -> Result<()> {
         let n = self.mesh.n_vertices();
-        let qk = self.state.q.clone();
+        // The start (moved by the carry of deforming obstacles, `contact::deforming`).
+        let mut qk = self.state.q.clone();
         let tc = Instant::now();
-        let fr = ipc.begin_step(&qk, t_next, h).map_err(|reason| Error::Diverged { step: self.steps, reason })?;
+        let fr = ipc.begin_step(&mut qk, t_next, h).map_err(|reason| Error::Diverged { step: self.steps, reason })?;
         // A delegated solve (tracks) that keeps the mesh's symbolic analysis works on the
         // fixed pattern: drop the contact couplings (their blocks are lumped, `Ipc::add`).
         let grow = solver.as_deref().is_none_or(|s| s.accepts_pattern_changes());

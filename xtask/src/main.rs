@@ -27,6 +27,7 @@ mod inspect;
 mod out;
 mod params;
 mod paths;
+mod pipeline;
 mod plot;
 mod preview;
 mod record;

@@ -90,6 +90,7 @@ pub fn runners() -> Vec<Runner> {
     crate::crates::flip_tet::register(&mut v);
     crate::crates::wrinkles::register(&mut v);
     crate::crates::cloth_fit::register(&mut v);
+    crate::pipeline::register(&mut v);
     v
 }
 

@@ -23,6 +23,7 @@
 
 pub mod accd;
 pub mod barrier;
+pub mod deforming;
 pub mod distance;
 pub(crate) mod friction;
 pub(crate) mod obstacle;
@@ -68,6 +69,12 @@ pub(crate) struct Ipc {
     mean_edge: f64,
     obstacles: Vec<Obstacle>,
     obstacle_edges: Vec<Vec<[u32; 2]>>,
+    /// Deforming-mesh obstacles with their edges (module [`deforming`]); placed after the rigid
+    /// ones (obstacle index `obstacles.len() + k`).
+    deforming: Vec<(deforming::DeformingMesh, Vec<[u32; 2]>)>,
+    /// True while [`Ipc::max_step`] checks the carry motion of a step's start, in which the
+    /// deforming obstacles move too (relative motion); false during the Newton iterations.
+    relative: bool,
     placed: Vec<Placed>,
     /// Activation distance d̂ (m).
     pub dhat: f64,
@@ -133,6 +140,8 @@ impl Ipc {
             mean_edge,
             obstacles: effects.obstacles.clone(),
             obstacle_edges,
+            deforming: Vec::new(),
+            relative: false,
             placed: Vec::new(),
             dhat,
             kappa,
@@ -150,11 +159,19 @@ impl Ipc {
         }
     }
 
+    /// Adds a deforming-mesh obstacle (module [`deforming`]); it is placed from the next step on.
+    pub(crate) fn add_deforming(&mut self, d: deforming::DeformingMesh) {
+        let e = obstacle::mesh_edges(d.tris());
+        self.deforming.push((d, e));
+    }
+
     /// Places the obstacles at the step's end t_next and freezes friction at the start `x0`
-    /// (contacts active there, normal forces κ|b′(d)|). Errors when an obstacle's new placement
-    /// intersects the cloth at the step's start (an obstacle moving by more than the gap in
-    /// one step): the step must be shortened.
-    pub(crate) fn begin_step(&mut self, x0: &[Pt3], t_next: f64, h: f64) -> Result<u32, String> {
+    /// (contacts active there, normal forces κ|b′(d)|). With deforming obstacles, `x0` is first
+    /// moved by the carry of [`deforming`] (the Newton solve's start; friction's reference
+    /// stays the unmoved start). Errors when an obstacle's new placement intersects the cloth
+    /// at the step's start (an obstacle moving by more than the gap in one step): the step
+    /// must be shortened.
+    pub(crate) fn begin_step(&mut self, x0: &mut [Pt3], t_next: f64, h: f64) -> Result<u32, String> {
         self.bp.next_step();
         let t_prev = t_next - h;
         self.placed = self
@@ -165,6 +182,10 @@ impl Ipc {
             .collect();
         self.x0 = x0.to_vec();
         self.eps = self.eps_v * h;
+        if !self.deforming.is_empty() {
+            self.carry(x0, t_prev, t_next)?;
+        }
+        let x0: &[Pt3] = x0;
         self.sweep(x0, None);
         let contacts = self.contacts(x0);
         let mut bad = 0u32;
@@ -181,6 +202,9 @@ impl Ipc {
             let shift = |p: &Pt3| -> Vec3 {
                 if c.obstacle == NONE {
                     return Vec3::zeros();
+                }
+                if c.obstacle as usize >= self.obstacles.len() {
+                    return self.deforming_shift(c, p);
                 }
                 let o = &self.obstacles[c.obstacle as usize];
                 match &o.motion {
@@ -209,6 +233,57 @@ impl Ipc {
             ));
         }
         Ok(self.friction.len() as u32)
+    }
+
+    /// The carry of a step's start (module [`deforming`]): places the deforming obstacles at
+    /// t_next (trees over their motion from t_prev), moves `x` by the carry displacement and
+    /// checks by CCD, the obstacles moving too, that the motion is intersection-free.
+    fn carry(&mut self, x: &mut [Pt3], t_prev: f64, t_next: f64) -> Result<(), String> {
+        let mut dx = vec![Vec3::zeros(); x.len()];
+        for (k, (d, e)) in self.deforming.iter().enumerate() {
+            let (p0, p1) = (d.positions(t_prev), d.positions(t_next));
+            deforming::add_carry(d.tris(), &p0, &p1, x, self.dhat, &mut dx)
+                .map_err(|err| format!("deforming obstacle {k}: {err}"))?;
+            self.placed.push(Placed::Core(Box::new(obstacle::Core::moving(&p0, p1, e.clone(), d.tris().to_vec()))));
+        }
+        self.relative = true;
+        self.sweep(x, Some(&dx));
+        let alpha = self.max_step(x, &dx);
+        self.relative = false;
+        if alpha < 1.0 {
+            return Err(format!(
+                "a deforming obstacle moves into the cloth within the step to t = {t_next} s (the carried start \
+                 allows {alpha:.3} of the motion): shorten the step"
+            ));
+        }
+        for (p, d) in x.iter_mut().zip(&dx) {
+            *p += d;
+        }
+        Ok(())
+    }
+
+    /// The displacement over the step of the deforming obstacle's point `p` of contact `c`
+    /// (one of the vertices of its obstacle feature).
+    fn deforming_shift(&self, c: &Contact, p: &Pt3) -> Vec3 {
+        let Some(Placed::Core(core)) = self.placed.get(c.obstacle as usize) else { return Vec3::zeros() };
+        for f in [c.key.0, c.key.1] {
+            let ids: Vec<u32> = match f {
+                set::Feat::OP(_, i) => vec![i],
+                set::Feat::OE(_, i) => core.edges[i as usize].to_vec(),
+                set::Feat::OT(_, i) => core.tris[i as usize].to_vec(),
+                _ => continue,
+            };
+            return core.shift_of(&ids, p);
+        }
+        Vec3::zeros()
+    }
+
+    /// Coulomb friction μ of placed obstacle `o` (rigid ones first, then deforming ones).
+    fn obstacle_friction(&self, o: usize) -> f64 {
+        match self.obstacles.get(o) {
+            Some(ob) => ob.friction,
+            None => self.deforming[o - self.obstacles.len()].0.friction,
+        }
     }
 
     /// Finds, with one broad phase, every pair that may come within d̂ anywhere on the straight
@@ -278,8 +353,8 @@ impl Ipc {
         let topo = Topo { tris: &self.tris, edges: &self.edges, mean_edge: self.mean_edge, mu_self: self.mu_self };
         let Some(c) = self.cands.as_ref() else { return Vec::new() };
         let mut all = if self.self_collision { set::self_contacts(&topo, x, &c.vt, &c.ee, dhat) } else { Vec::new() };
-        for (o, ((p, ob), oc)) in self.placed.iter().zip(&self.obstacles).zip(&c.obs).enumerate() {
-            all.extend(set::obstacle_contacts(&topo, x, o as u32, p, oc, ob.friction, dhat));
+        for (o, (p, oc)) in self.placed.iter().zip(&c.obs).enumerate() {
+            all.extend(set::obstacle_contacts(&topo, x, o as u32, p, oc, self.obstacle_friction(o), dhat));
         }
         set::dedup(all)
     }
@@ -389,7 +464,7 @@ impl Ipc {
                 .reduce(|| 1.0, f64::min);
         let mut alpha = a_vt.min(a_ee);
         for (p, oc) in self.placed.iter().zip(&c.obs) {
-            alpha = alpha.min(obstacle_toi(p, oc, x, dx, tris, edges, floor));
+            alpha = alpha.min(obstacle_toi(p, oc, x, dx, tris, edges, floor, self.relative));
         }
         alpha
     }
@@ -420,7 +495,10 @@ fn toi4(x: &[Pt3; 4], dx: &[Vec3; 4], split: usize, d2: fn(&[Pt3; 4]) -> f64, xi
     accd::time_of_impact(x, dx, split, d2, xi, CCD_KEEP, floor, 1.0).unwrap_or(1.0)
 }
 
-/// Step bound from one placed obstacle (fixed during the step's Newton iterations).
+/// Step bound from one placed obstacle (fixed during the step's Newton iterations; with
+/// `relative`, a deforming mesh moves from its step-start to its end positions together with
+/// the cloth: additive CCD of the relative motion).
+#[allow(clippy::too_many_arguments)]
 fn obstacle_toi(
     p: &Placed,
     c: &set::CoreCands,
@@ -429,6 +507,7 @@ fn obstacle_toi(
     tris: &[[u32; 3]],
     edges: &[[u32; 2]],
     floor: f64,
+    relative: bool,
 ) -> f64 {
     match p {
         Placed::Half { normal, offset } => x
@@ -450,28 +529,33 @@ fn obstacle_toi(
             .reduce(|| 1.0, f64::min),
         Placed::Core(core) => {
             let z = Vec3::zeros();
-            let pt = |i: u32| core.points[i as usize];
+            let moving = relative && !core.disp.is_empty();
+            // The obstacle's points at the motion's start and their displacements.
+            let pt =
+                |i: u32| if moving { core.points[i as usize] - core.disp[i as usize] } else { core.points[i as usize] };
+            let od = |i: u32| if moving { core.disp[i as usize] } else { z };
             let mut alpha: f64 = 1.0;
             for &(v, t) in &c.v_ot {
                 let (v, ot) = (v as usize, core.tris[t as usize]);
                 let y = [x[v], pt(ot[0]), pt(ot[1]), pt(ot[2])];
-                alpha = alpha.min(toi4(&y, &[dx[v], z, z, z], 1, pt_d2, core.xi, floor));
+                alpha = alpha.min(toi4(&y, &[dx[v], od(ot[0]), od(ot[1]), od(ot[2])], 1, pt_d2, core.xi, floor));
             }
             for &(e, f) in &c.e_oe {
                 let (a, ob) = (edges[e as usize], core.edges[f as usize]);
                 let y = [x[a[0] as usize], x[a[1] as usize], pt(ob[0]), pt(ob[1])];
-                alpha = alpha.min(toi4(&y, &[dx[a[0] as usize], dx[a[1] as usize], z, z], 2, ee_d2, core.xi, floor));
+                let d = [dx[a[0] as usize], dx[a[1] as usize], od(ob[0]), od(ob[1])];
+                alpha = alpha.min(toi4(&y, &d, 2, ee_d2, core.xi, floor));
             }
             for &(v, q) in &c.v_op {
                 let v = v as usize;
                 let pp = |y: &[Pt3; 2]| (y[0] - y[1]).norm_squared();
-                let t = accd::time_of_impact(&[x[v], pt(q)], &[dx[v], z], 1, pp, core.xi, CCD_KEEP, floor, 1.0);
+                let t = accd::time_of_impact(&[x[v], pt(q)], &[dx[v], od(q)], 1, pp, core.xi, CCD_KEEP, floor, 1.0);
                 alpha = alpha.min(t.unwrap_or(1.0));
             }
             for &(t, q) in &c.t_op {
                 let tri = tris[t as usize];
                 let y = [pt(q), x[tri[0] as usize], x[tri[1] as usize], x[tri[2] as usize]];
-                let d = [z, dx[tri[0] as usize], dx[tri[1] as usize], dx[tri[2] as usize]];
+                let d = [od(q), dx[tri[0] as usize], dx[tri[1] as usize], dx[tri[2] as usize]];
                 alpha = alpha.min(toi4(&y, &d, 1, pt_d2, core.xi, floor));
             }
             alpha

@@ -33,8 +33,12 @@ pub(crate) struct Core {
     pub edges: Vec<[u32; 2]>,
     /// Triangles as point index triples (mesh faces).
     pub tris: Vec<[u32; 3]>,
-    /// Trees over the points, edges and triangles (boxes grown by ξ).
+    /// Trees over the points, edges and triangles (boxes grown by ξ; a deforming mesh's boxes
+    /// cover the step's start and end positions).
     pub trees: [AabbTree; 3],
+    /// A deforming mesh's point displacements over the step (m; `points` − `disp` are the
+    /// step-start positions); empty for rigid obstacles, whose points are fixed in a step.
+    pub disp: Vec<Vec3>,
 }
 
 impl Core {
@@ -44,7 +48,28 @@ impl Core {
         let tb: Vec<Aabb> =
             tris.iter().map(|t| pb[t[0] as usize].union(&pb[t[1] as usize]).union(&pb[t[2] as usize])).collect();
         let trees = [AabbTree::build(&pb), AabbTree::build(&eb), AabbTree::build(&tb)];
-        Self { xi, points, edges, tris, trees }
+        Self { xi, points, edges, tris, trees, disp: Vec::new() }
+    }
+
+    /// A deforming mesh moving from `start` to `end` over the step (module `deforming`): the
+    /// contact geometry is `end`, the trees' boxes cover both.
+    pub(crate) fn moving(start: &[Pt3], end: Vec<Pt3>, edges: Vec<[u32; 2]>, tris: Vec<[u32; 3]>) -> Self {
+        let pb: Vec<Aabb> = start.iter().zip(&end).map(|(a, b)| Aabb::from_points(&[*a, *b])).collect();
+        let eb: Vec<Aabb> = edges.iter().map(|e| pb[e[0] as usize].union(&pb[e[1] as usize])).collect();
+        let tb: Vec<Aabb> =
+            tris.iter().map(|t| pb[t[0] as usize].union(&pb[t[1] as usize]).union(&pb[t[2] as usize])).collect();
+        let trees = [AabbTree::build(&pb), AabbTree::build(&eb), AabbTree::build(&tb)];
+        let disp = start.iter().zip(&end).map(|(a, b)| b - a).collect();
+        Self { xi: 0.0, points: end, edges, tris, trees, disp }
+    }
+
+    /// The displacement over the step of the obstacle point at `p` (one of `points`), found
+    /// among the vertices `ids` of a contact's obstacle feature; zero for rigid obstacles.
+    pub(crate) fn shift_of(&self, ids: &[u32], p: &Pt3) -> Vec3 {
+        ids.iter()
+            .find(|&&i| self.points.get(i as usize) == Some(p))
+            .and_then(|&i| self.disp.get(i as usize).copied())
+            .unwrap_or_else(Vec3::zeros)
     }
 }
 
