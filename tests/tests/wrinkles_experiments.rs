@@ -5,7 +5,7 @@
 use geom_core::experiment::Size;
 use geom_core::record::NullRecorder;
 use tests::{assert_checks_pass, assert_thread_independent, scene_params};
-use wrinkles::experiments::{four_stage, precompute_cost, realtime_small, uniaxial};
+use wrinkles::experiments::{four_stage, precompute_cost, realtime_small, uniaxial, vs_fine};
 
 macro_rules! tiny {
     ($m:ident, $id:literal) => {{
@@ -42,6 +42,27 @@ fn realtime_small() {
     assert!(r.get_f64("last_displaced_area_m2") > 0.3 * 0.3, "wrinkles add area to the 0.3 m sheet");
 }
 
+/// W4 at the test size (fine 8², coarse 12², 0.2 s): both cloths stay physical (no NaN, no
+/// self-intersection, bounded strain), the designed pattern and every fold statistic are
+/// finite, the wrinkles add area to the compressed coarse ROI, and the figures do not depend on
+/// the thread count (the cost figures are timings).
+#[test]
+fn vs_fine() {
+    let r = tiny!(vs_fine, "wrinkles/vs-fine");
+    for k in ["fine8_nan_steps", "coarse_nan_steps", "fine8_max_intersections", "coarse_max_intersections"] {
+        assert_eq!(r.get_f64(k), 0.0, "{k}");
+    }
+    assert!(r.get_f64("fine8_max_edge_strain") < 0.10);
+    for k in ["design_lambda_m", "sigma_m", "fine8_rms_d_m", "wrinkled_rms_d_m", "wrinkled_area_ratio"] {
+        assert!(r.get_f64(k).is_finite() && r.get_f64(k) > 0.0, "{k} = {}", r.get_f64(k));
+    }
+    assert!(
+        r.get_f64("wrinkled_area_ratio") > r.get_f64("coarse_area_ratio"),
+        "wrinkles restore area lost by the gathered coarse cloth"
+    );
+    assert!(r.get_f64("cost_ratio_fine_over_coarse") > 0.0);
+}
+
 #[test]
 fn bad_parameters_are_errors() {
     let mut p: four_stage::Params = scene_params("wrinkles/four-stage");
@@ -51,4 +72,8 @@ fn bad_parameters_are_errors() {
     let mut u: uniaxial::Params = scene_params("wrinkles/uniaxial");
     u.tolerance = geom_core::experiment::BySize::Same(-1.0);
     assert!(uniaxial::run(&u, Size::Tiny, &mut NullRecorder::default()).is_err());
+    let mut v: vs_fine::Params = scene_params("wrinkles/vs-fine");
+    v.roi = [[0.0, 0.0], [2.0, 2.0]];
+    let e = vs_fine::run(&v, Size::Tiny, &mut NullRecorder::default()).unwrap_err();
+    assert!(e.to_string().contains("roi"), "{e}");
 }

@@ -238,6 +238,53 @@ impl Cloth {
         Self::start(desc, rest, Some((n, n)), m)
     }
 
+    /// The W2 sheet of the four-stage demonstration (spec §6 W2) on the wrinkle rest mesh itself
+    /// (same vertices and faces, so positions pass straight to the animator): no gravity, the
+    /// vertices at y = `side` (the top edge) pinned, the two bottom corners (y = 0, x = 0 and
+    /// x = `side`) displaced by `corner(t)` (m).
+    pub fn four_stage_sheet(
+        mesh: &RestMesh,
+        side: f64,
+        corner: impl Fn(f64) -> geom_core::math::Vec2 + Send + Sync + 'static,
+        m: &ClothModel,
+    ) -> Result<Self> {
+        check_model(m)?;
+        let tol = 1e-9 * side;
+        let p = &mesh.positions;
+        let top: Vec<u32> = (0..p.len() as u32).filter(|&i| (p[i as usize].y - side).abs() <= tol).collect();
+        let corners: Vec<u32> = (0..p.len() as u32)
+            .filter(|&i| {
+                let q = p[i as usize];
+                q.y.abs() <= tol && (q.x.abs() <= tol || (q.x - side).abs() <= tol)
+            })
+            .collect();
+        if top.is_empty() || corners.len() != 2 {
+            return Err(WrinkleError::InvalidOption(format!(
+                "four-stage sheet: expected a top edge at y = {side} and two bottom corners, found {} and {}",
+                top.len(),
+                corners.len()
+            )));
+        }
+        let rest_c = p.clone();
+        let path: shells::KinematicFn = Box::new(move |t, i| {
+            let d = corner(t);
+            rest_c[i as usize] + Vec3::new(d.x, d.y, 0.0)
+        });
+        let desc = ShellSceneDesc {
+            rest: p.clone(),
+            faces: mesh.faces.clone(),
+            uv: Some(mesh.uvs.clone()),
+            initial: None,
+            initial_velocity: None,
+            material: m.material.clone(),
+            effects: effects(m, None, Vec::new()),
+            constraints: vec![VertexConstraint::Pinned(top), VertexConstraint::Kinematic(corners, path)],
+            integrator: m.integrator.settings(),
+            t0: 0.0,
+        };
+        Self::start(desc, mesh.clone(), None, m)
+    }
+
     /// The sleeve with `around` vertices per ring and `rings` rings (spec's 16 × 12 quads =
     /// `around` 16, `rings` 13).
     pub fn sleeve(s: &Sleeve, around: u32, rings: u32, m: &ClothModel) -> Result<Self> {
@@ -324,7 +371,7 @@ impl Cloth {
         let desc = ShellSceneDesc {
             rest: tm.positions.clone(),
             faces: tm.faces.clone(),
-            uv: None,
+            uv: Some(Uv::PerCorner(uv.clone())),
             initial: Some(initial),
             initial_velocity: None,
             material: m.material.clone(),

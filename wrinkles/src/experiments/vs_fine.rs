@@ -387,10 +387,10 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         Ok(())
     };
     for fr in &fines {
-        emit("fine", fr.quads, &fr.rows, rec)?;
+        emit("fine", fr.quads, &fr.rows, &mut *rec)?;
     }
-    emit("coarse+wrinkles", p.coarse_quads, &rows, rec)?;
-    emit("coarse+linear", p.coarse_quads, &lin_rows, rec)?;
+    emit("coarse+wrinkles", p.coarse_quads, &rows, &mut *rec)?;
+    emit("coarse+linear", p.coarse_quads, &lin_rows, &mut *rec)?;
     let curve = |label: String, pts: Vec<(f64, f64)>| Series {
         plot: "area_ratio_vs_time".into(),
         label,
