@@ -64,6 +64,11 @@ pub struct Params {
     /// Gather duration per run size (s), overriding `curtain.gather_s` (the test run is short).
     #[serde(default)]
     pub gather_s: Option<BySize<f64>>,
+    /// Out-of-plane noise of the coarse cloth's initial positions (m), overriding
+    /// `curtain.noise_m` for the coarse run only (0: the coarse sheet stays planar and takes the
+    /// gather as in-plane compression, which the wrinkles turn back into area).
+    #[serde(default)]
+    pub coarse_noise_m: Option<f64>,
     /// Fine pipeline (stiff membrane).
     pub fine: ClothModel,
     /// Coarse pipeline (soft membrane, same bending).
@@ -137,6 +142,7 @@ fn check(p: &Params, c: &Curtain, fine: &[u32], frames: usize) -> Result<()> {
         || p.level == 0
         || p.intersections_every == 0
         || p.fine.integrator.fps != p.coarse.integrator.fps
+        || p.coarse_noise_m.is_some_and(|n| !(n >= 0.0))
     {
         return Err(bad(
             "sample_dx, sigma0, slope, max_slope, flat_at_rest_scale must be > 0, level and intersections_every ≥ 1, \
@@ -265,7 +271,9 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     }
 
     // Coarse + wrinkles.
-    let mut cl = Cloth::curtain(c, p.coarse_quads, &p.coarse)?;
+    let mut cc = c.clone();
+    cc.noise_m = p.coarse_noise_m.unwrap_or(c.noise_m);
+    let mut cl = Cloth::curtain(&cc, p.coarse_quads, &p.coarse)?;
     let pattern = sinusoid(f_lambda, f_orient, p.slope)?;
     let pre = PrecomputeOptions { tolerance: p.tolerance, ..Default::default() };
     let (rig, pre_wall, pre_cpu) = timed(|| precompute(&cl.rest, std::slice::from_ref(&pattern), &pre));
