@@ -5,7 +5,7 @@
 use geom_core::experiment::Size;
 use geom_core::record::NullRecorder;
 use tests::{assert_checks_pass, assert_thread_independent, scene_params};
-use wrinkles::experiments::{four_stage, precompute_cost, realtime_small, uniaxial, vs_fine};
+use wrinkles::experiments::{four_stage, precompute_cost, realtime_small, sleeve, uniaxial, vs_fine};
 
 macro_rules! tiny {
     ($m:ident, $id:literal) => {{
@@ -26,6 +26,29 @@ fn uniaxial() {
 fn four_stage() {
     let r = tiny!(four_stage, "wrinkles/four-stage");
     assert_checks_pass("four-stage", &r);
+}
+
+/// W2 driven by the coarse `shells` sheet (the spec's setup) at the test size: the W2 criteria
+/// hold on real cloth too, and the cloth stays free of NaN and self-intersections.
+#[test]
+fn four_stage_shells() {
+    let r = tiny!(four_stage, "wrinkles/four-stage-shells");
+    for k in ["stage1_max_abs_mf_minus_1", "ordering_swaps", "mid_stage2_dominant_weight", "cloth_nan_steps"] {
+        let c = r.checks.iter().find(|c| c.key == k).unwrap_or_else(|| panic!("no check {k}"));
+        assert!(c.target.holds(c.value), "{k} = {}", c.value);
+    }
+    assert_eq!(r.get_f64("cloth_max_intersections"), 0.0);
+    assert!(r.get_f64("cloth_steps") > 0.0);
+}
+
+/// W3 at the test size: the sleeve stays physical around the arm (no NaN, no penetration, no
+/// self-intersection) and the wrinkles give back area the compressed coarse sleeve lost.
+#[test]
+fn sleeve() {
+    let r = tiny!(sleeve, "wrinkles/sleeve");
+    assert_checks_pass("sleeve", &r);
+    assert!(r.get_f64("hold_area_ratio_coarse") < 1.0, "the cuff's rise compresses the sleeve");
+    assert!(r.get_f64("hold_area_ratio_exact") > r.get_f64("hold_area_ratio_coarse"));
 }
 
 #[test]
