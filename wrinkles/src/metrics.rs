@@ -139,7 +139,9 @@ pub fn sample_grid_surface(q: &[Pt3], nx: usize, ny: usize, size: (f64, f64), uv
     let (a, b) = (fx - i as f64, fy - j as f64);
     let p = |i: usize, j: usize| q[j * nx + i].coords;
     Pt3::from(
-        p(i, j) * ((1.0 - a) * (1.0 - b)) + p(i + 1, j) * (a * (1.0 - b)) + p(i, j + 1) * ((1.0 - a) * b)
+        p(i, j) * ((1.0 - a) * (1.0 - b))
+            + p(i + 1, j) * (a * (1.0 - b))
+            + p(i, j + 1) * ((1.0 - a) * b)
             + p(i + 1, j + 1) * (a * b),
     )
 }
@@ -305,11 +307,8 @@ mod tests {
     fn fold_stats_of_a_sinusoid() {
         let lambda = 0.05;
         let g = MaterialGrid::covering(Pt2::new(0.0, 0.0), Pt2::new(0.5, 0.2), lambda / 16.0);
-        let d: Vec<f64> = g
-            .points()
-            .iter()
-            .map(|p| 0.01 * (2.0 * std::f64::consts::PI * p.x / lambda + 0.3).sin())
-            .collect();
+        let d: Vec<f64> =
+            g.points().iter().map(|p| 0.01 * (2.0 * std::f64::consts::PI * p.x / lambda + 0.3).sin()).collect();
         let s = fold_stats(&d, &g, Pt2::new(0.0, 0.0), Pt2::new(0.5, 0.2));
         assert!((s.lambda_hat - lambda).abs() < 0.01 * lambda, "{s:?}");
         assert!(s.orient_deg.abs() < 1e-9, "{s:?}");

@@ -389,7 +389,16 @@ impl Cloth {
         let sim = ShellSim::new(desc).map_err(driver)?;
         let sanity = Sanity::new(&sim.mesh().rest, &sim.mesh().edges, obstacles, None);
         let it = &m.integrator;
-        Ok(Self { sim, sanity, rest, grid, h: it.h(), substeps: it.substeps, fps: it.fps, stats: ClothStats::default() })
+        Ok(Self {
+            sim,
+            sanity,
+            rest,
+            grid,
+            h: it.h(),
+            substeps: it.substeps,
+            fps: it.fps,
+            stats: ClothStats::default(),
+        })
     }
 
     /// Current positions (m).

@@ -129,8 +129,11 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let fps = cl.fps;
     let at = |t: f64| (t * fps).round() as usize;
     let f_rise = at(s.rise_s);
-    let (f_hold, f_plus, f_minus) =
-        (at(s.rise_s + s.hold_s), at(s.rise_s + s.hold_s + 0.25 * s.twist_s), at(s.rise_s + s.hold_s + 0.75 * s.twist_s));
+    let (f_hold, f_plus, f_minus) = (
+        at(s.rise_s + s.hold_s),
+        at(s.rise_s + s.hold_s + 0.25 * s.twist_s),
+        at(s.rise_s + s.hold_s + 0.75 * s.twist_s),
+    );
     rec.scene(&SceneItem::FrameRate { fps: cl.fps })?;
     for o in &cl.sim.effects().obstacles {
         if let shells::ObstacleShape::Capsule { a, b, radius } = &o.shape {
@@ -211,7 +214,14 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         }
         if p.frame_every > 0 && f % p.frame_every == 0 {
             let i = f / p.frame_every;
-            rec.frame(&MeshFrame { sequence: "frames", index: i, time: t, positions: &q, faces: &faces, attributes: &[] })?;
+            rec.frame(&MeshFrame {
+                sequence: "frames",
+                index: i,
+                time: t,
+                positions: &q,
+                faces: &faces,
+                attributes: &[],
+            })?;
             rec.frame(&MeshFrame {
                 sequence: "wrinkled",
                 index: i,

@@ -22,7 +22,8 @@
 //! `cost_ratio_fine_over_coarse` (process CPU per frame of the finest run over the coarse
 //! pipeline's sim + modulation + level-L mesh), `cost_ratio_wall`, `coarse_{sim,mod,mesh}_cpu_ms`,
 //! `design_lambda_m`, `design_angle_deg`, `sigma_m`, `lambda_convergence` (|λ̂ of the two finest
-//! runs − 1|), and the coarse cloth's sanity (`coarse_max_edge_strain` …).
+//! runs − 1|), and the coarse cloth's sanity (`coarse_max_edge_strain` …). Frames: `fine<q>`
+//! (every fine run) and `wrinkled` (the coarse cloth's level-L displaced mesh).
 //!
 //! ```no_run
 //! use geom_core::experiment::Size;
@@ -132,10 +133,7 @@ fn check(p: &Params, c: &Curtain, fine: &[u32], frames: usize) -> Result<()> {
         return Err(bad(format!("duration must extend past the gather ({} s)", c.gather_s)));
     }
     let [lo, hi] = p.roi;
-    if !(lo[0] < hi[0] && lo[1] < hi[1] && lo[0] >= 0.0 && lo[1] >= 0.0)
-        || hi[0] > c.width
-        || hi[1] > c.height
-    {
+    if !(lo[0] < hi[0] && lo[1] < hi[1] && lo[0] >= 0.0 && lo[1] >= 0.0) || hi[0] > c.width || hi[1] > c.height {
         return Err(bad(format!("roi {:?} must be a non-empty box inside the sheet", p.roi)));
     }
     if !(p.sample_dx > 0.0 && p.sigma0 > 0.0 && p.slope > 0.0 && p.max_slope > 0.0 && p.flat_at_rest_scale > 0.0)
@@ -193,7 +191,13 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         for f in 1..=frames {
             let (wall, cpu) = cl.advance_frame()?;
             let ar = area_ratio_in(&faces, cl.positions(), |f, k| cl.rest.uv(f, k), lo, hi);
-            rows.push(FrameRow { t: cl.time(), wall: [wall, 0.0, 0.0], cpu: [cpu, 0.0, 0.0], area_ratio: ar, stats: None });
+            rows.push(FrameRow {
+                t: cl.time(),
+                wall: [wall, 0.0, 0.0],
+                cpu: [cpu, 0.0, 0.0],
+                area_ratio: ar,
+                stats: None,
+            });
             if f >= w0 {
                 window.push(cl.positions().to_vec());
             }
@@ -231,7 +235,8 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     for fr in &mut fines {
         for (k, x) in fr.window.iter().enumerate() {
             let xs = sample(fr.quads, x);
-            fr.rows[fr.first_window_frame + k].stats = Some(fold_stats(&detail_height(&xs, &grid, sigma), &grid, lo, hi));
+            fr.rows[fr.first_window_frame + k].stats =
+                Some(fold_stats(&detail_height(&xs, &grid, sigma), &grid, lo, hi));
         }
     }
     let wmean = |rows: &[FrameRow], f: &dyn Fn(&FrameRow) -> f64| -> f64 {
@@ -321,7 +326,6 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
             cl.count_intersections();
         }
         if p.frame_every > 0 && f % p.frame_every == 0 {
-            frame(rec, "coarse", f / p.frame_every, cl.time(), &q, &cfaces)?;
             frame(rec, "wrinkled", f / p.frame_every, cl.time(), &dm.positions, &dm.faces)?;
         }
         done += 1;
@@ -386,7 +390,12 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     )?;
     let emit = |pipe: &str, res: u32, rows: &[FrameRow], rec: &mut dyn Recorder| -> Result<()> {
         for (f, x) in rows.iter().enumerate() {
-            let s = x.stats.unwrap_or(FoldStats { rms: f64::NAN, orient_deg: f64::NAN, lambda_hat: f64::NAN, folds: f64::NAN });
+            let s = x.stats.unwrap_or(FoldStats {
+                rms: f64::NAN,
+                orient_deg: f64::NAN,
+                lambda_hat: f64::NAN,
+                folds: f64::NAN,
+            });
             let mut cells = vec![Cell::from(pipe), Cell::Int(res as i64), Cell::Int(f as i64), Cell::from(x.t)];
             cells.extend(x.wall.iter().chain(&x.cpu).map(|v| Cell::from(1e3 * v)));
             cells.extend([x.area_ratio, s.rms, s.orient_deg, s.lambda_hat].map(Cell::from));
