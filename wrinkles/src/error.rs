@@ -39,6 +39,10 @@ pub enum WrinkleError {
     /// An option or parameter is out of range (the message names it and its value).
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// The cloth simulation driving a scene (`shells`, feature `shells`) failed; the message
+    /// names the simulator's error.
+    #[error("cloth simulation: {0}")]
+    Driver(String),
     /// The area-consistent smoothing system is singular (μ = 0 and a vertex touches no valid
     /// triangle, or an isolated vertex); raised at construction, never mid-animation (spec §3.9).
     #[error("area-consistent smoothing system is singular (pattern {pattern}, vertex {vertex}): raise mu or remove isolated vertices")]

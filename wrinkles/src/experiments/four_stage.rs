@@ -1,10 +1,14 @@
 //! W2 (spec §6): the paper's four-stage demonstration (Fig. 7–11). Two orthogonal fold patterns
-//! (±45°) on a square sheet whose bottom corners are pulled left, released and pulled right by a
-//! prescribed smooth shear (top edge fixed); per frame the marked triangle's modulation factors
-//! and pattern weights, and the popping index of blend power n = 4 against n = ∞.
+//! (±45°) on a square sheet whose bottom corners are pulled left, released and pulled right (top
+//! edge fixed); per frame the marked triangle's modulation factors and pattern weights, and the
+//! popping index of blend power n = 4 against n = ∞. Two drivers: a prescribed smooth shear
+//! field (`four-stage`), or — the spec's setup — a coarse `shells` simulation of the sheet with
+//! the soft membrane (`four-stage-shells`, params `shells: (…)`, crate feature `shells`), which
+//! adds the cloth's sanity figures `cloth_max_edge_strain`, `cloth_max_edge_compression`,
+//! `cloth_max_intersections`, `cloth_nan_steps` … and their checks.
 //!
 //! Outputs: table `metrics` (per frame), plots `mf1_vs_mf2` and `weights_vs_time`, displaced
-//! frames `frames/frame_NNNN.obj` every `obj_every` frames and 16-bit modulation maps
+//! mesh frames (sequence `frames`, through the recorder) every `obj_every` frames and 16-bit modulation maps
 //! `modmap_p<i>_NNNN.png` every `modmap_every` frames. Figures: `stage1_max_abs_mf_minus_1`,
 //! `stage3_end_max_abs_mf_minus_1`, `mid_stage2_mf1`, `mid_stage2_mf2`, `mid_stage4_mf1`,
 //! `mid_stage4_mf2`, `mid_stage2_dominant_weight`, `mid_stage4_dominant_weight`,
@@ -30,9 +34,8 @@ use std::time::Instant;
 
 use geom_core::experiment::{BySize, Report, Size, Target};
 use geom_core::image::encode_png_gray16;
-use geom_core::io::{obj, MeshOut};
 use geom_core::math::Vec2;
-use geom_core::record::{Recorder, Series};
+use geom_core::record::{MeshFrame, Recorder, SceneItem, Series};
 use geom_core::stats::nan_max;
 use serde::Deserialize;
 
@@ -86,6 +89,12 @@ pub struct Params {
     /// Quadrature tolerance of the precomputation (default: `PrecomputeOptions`' 1e-4).
     #[serde(default = "default_tolerance")]
     pub tolerance: BySize<f64>,
+    /// The spec's driver: a coarse `shells` simulation of the sheet (top edge pinned, bottom
+    /// corners kinematic, no gravity; its fps must equal `fps`). `None` (the default): the
+    /// prescribed smooth shear field. Needs the crate feature `shells`.
+    #[cfg(feature = "shells")]
+    #[serde(default)]
+    pub shells: Option<super::cloth::ClothModel>,
 }
 
 fn default_tolerance() -> BySize<f64> {
@@ -131,10 +140,30 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let marked = triangle_at(&mesh, Vec2::new(p.marked[0], p.marked[1]))
         .ok_or_else(|| WrinkleError::InvalidOption(format!("marked point {:?} is outside the sheet", p.marked)))?;
     let n_frames = (4.0 * p.stage_seconds * fps).round() as usize;
+    #[cfg(feature = "shells")]
+    let mut cloth = match &p.shells {
+        Some(m) => {
+            if m.integrator.fps != fps {
+                return Err(WrinkleError::InvalidOption(format!(
+                    "shells.integrator.fps ({}) must equal fps ({fps})",
+                    m.integrator.fps
+                )));
+            }
+            let (corner, ss, tr) = (p.corner, p.stage_seconds, p.transition);
+            Some(super::cloth::Cloth::four_stage_sheet(
+                &mesh,
+                p.size,
+                move |t| four_stage_corner(corner, ss, tr, t),
+                m,
+            )?)
+        }
+        None => None,
+    };
     let obj_every = p.obj_every.get(size).max(1);
     let refine = Refinement::new(mesh.positions.len(), &mesh.faces, &rig.edges, p.obj_level.max(1));
     // Probe points for the popping index: the level-4 lattice of every triangle.
     let probes = probe_lattice(mesh.faces.len(), 4);
+    rec.scene(&SceneItem::FrameRate { fps: fps / obj_every as f64 })?;
     rec.table(
         "metrics",
         &[
@@ -163,6 +192,19 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         rec.progress(k as u64, n_frames as u64);
         let t = k as f64 / fps;
         let def = sheared(&mesh, p.size, four_stage_corner(p.corner, p.stage_seconds, p.transition, t));
+        #[cfg(feature = "shells")]
+        let def = match cloth.as_mut() {
+            Some(c) => {
+                if k > 0 {
+                    c.advance_frame()?;
+                }
+                if k % 10 == 0 || k + 1 == n_frames {
+                    c.count_intersections();
+                }
+                c.positions().to_vec()
+            }
+            None => def,
+        };
         let t0 = Instant::now();
         let fm = a4.frame(&def)?;
         let dt_mod = t0.elapsed().as_secs_f64();
@@ -199,8 +241,14 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
             let dm = a4.displaced_on(&refine, &def, &fm);
             dt_mesh = t1.elapsed().as_secs_f64();
             if rec.keeps_outputs() {
-                let text = obj::to_string(&MeshOut::tri(&dm.positions, &dm.faces).with_uv(&dm.uv))?;
-                rec.file(&format!("frames/frame_{k:04}.obj"), text.as_bytes())?;
+                rec.frame(&MeshFrame {
+                    sequence: "frames",
+                    index: k / obj_every,
+                    time: t,
+                    positions: &dm.positions,
+                    faces: &dm.faces,
+                    attributes: &[],
+                })?;
             }
         }
         if p.modmap_every > 0 && k % p.modmap_every == 0 && rec.keeps_outputs() {
@@ -265,5 +313,14 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     r.check("mid_stage2_dominant_weight", Target::AtLeast(0.9), "paper Fig. 11: one pattern dominates");
     r.check("mid_stage4_dominant_weight", Target::AtLeast(0.9), "paper Fig. 11: one pattern dominates");
     r.check("pass", Target::Equals(1.0), "spec W2: all criteria, popping n = 4 below n = ∞");
+    #[cfg(feature = "shells")]
+    if let Some(c) = &cloth {
+        c.figures(&mut r, "cloth_");
+        let src = "issue 20 (contact invariants)";
+        r.check("cloth_nan_steps", Target::Equals(0.0), src);
+        r.check("cloth_max_intersections", Target::Equals(0.0), src);
+        r.check("cloth_max_edge_strain", Target::AtMost(0.10), src);
+        r.check("cloth_max_edge_compression", Target::AtMost(0.5), src);
+    }
     Ok(r)
 }
