@@ -20,7 +20,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let setup = EvalSetup {
         rig,
         model: cloth_fit::forward::SimOptions { res, dt, ..fit_model() },
-        render: Default::default(),
+        render: cloth_fit::render::RenderOptions {
+            shadows: std::env::var("SHADOWS").map_or(true, |v| v != "0"),
+            supersample: std::env::var("SS").ok().and_then(|v| v.parse().ok()).unwrap_or(2),
+            ..Default::default()
+        },
         angle: AngleOptions { grad_threshold: 0.01 * 320.0 / w as f64, ..AngleOptions::default() },
         metric: Default::default(),
     };
@@ -37,9 +41,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for k in 0..repeats {
             let obj = Objective::new(&targets, &fwd, &space, &setup)?;
             let p = truth.with(ParamId::Bend, truth.bend * (1.0 + 0.1 * k as f64));
-            let r = obj.eval_params(&[p]).remove(0);
+            let (mut r, _, cpu) = cloth_fit::cpu_time::timed(|| obj.eval_params(&[p]));
+            let r = r.remove(0);
             println!(
-                "{name}: E = {:.4}  wall {:.3} s  (sim {:.3}, render {:.3}, filter {:.3}, metric {:.3} summed over frames)",
+                "{name}: E = {:.4}  wall {:.3} s  CPU {cpu:.2} s  (sim {:.3}, render {:.3}, filter {:.3}, metric {:.3} summed over frames)",
                 r.error, r.wall_s, r.sim_s, r.render_s, r.filter_s, r.metric_s
             );
         }

@@ -41,6 +41,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     if let Some(h) = env("RELAX_DT") {
         e.settle.relax_dt = h;
     }
+    if let Some(n) = env("QS") {
+        e.settle.quasi_static_steps = n as usize;
+    }
     let t = truths(&fwd, &[e], truth, &setup, Condition::Matched, Default::default())?;
     let targets = [t[0].target.clone()];
     let sp = space(&ParamId::CLOTH, truth)?;
@@ -55,6 +58,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             line += &format!(" {d:+}:{:.3}({:.3}/{})", r.error, r.fold, r.silh);
         }
         println!("{line}");
+        let h = obj.history();
+        let walls: Vec<f64> = h.iter().filter(|r| !r.cached).map(|r| r.sim_s).collect();
+        println!("{:12} median simulation {:.3} s", "", geom_core::stats::median(&walls));
     }
     Ok(())
 }

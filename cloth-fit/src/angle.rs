@@ -134,53 +134,66 @@ fn orientation_window(img: &ImageF32, out: Rect, o: &AngleOptions) -> (Vec<f32>,
     let rw = Rect { x0: cw.x0, x1: cw.x1, y0: (cw.y0 - r).max(0), y1: (cw.y1 + r).min(h) }; // row-pass window
     let clampx = |x: i64| x.clamp(0, w - 1);
     let clampy = |y: i64| y.clamp(0, h - 1);
-    // 1. Row passes of the five 1-D pieces over the row window.
+    // Every sum below runs over its taps in increasing order for each pixel, the loops being
+    // arranged row by row (tap outermost, pixels innermost) so that the compiler vectorises them;
+    // the values are bitwise those of the per-pixel loops.
+    // 1. Row passes of the five 1-D pieces over the row window (a clamped, padded copy of each
+    //    image row: pad[xx + k] = img(clamp(x0 + xx + k − r))).
     let pieces: [&[f64]; 5] = [&basis.g0, &basis.g1, &basis.g2, &basis.h1, &basis.h3];
     let (rww, rwh) = (rw.w(), rw.h());
+    let taps = (2 * r + 1) as usize;
     let mut rows = vec![vec![0.0f64; rww * rwh]; 5];
+    let mut pad = vec![0.0f64; rww + taps - 1];
     for yy in 0..rwh {
         let y = rw.y0 + yy as i64;
         let line = &img.data[(y * w) as usize..((y + 1) * w) as usize];
-        for xx in 0..rww {
-            let x = rw.x0 + xx as i64;
-            let mut acc = [0.0f64; 5];
-            for k in 0..(2 * r + 1) {
-                let v = line[clampx(x + k - r) as usize] as f64;
-                for (a, p) in acc.iter_mut().zip(&pieces) {
-                    *a += p[k as usize] * v;
+        for (j, v) in pad.iter_mut().enumerate() {
+            *v = line[clampx(rw.x0 + j as i64 - r) as usize] as f64;
+        }
+        for (q, p) in pieces.iter().enumerate() {
+            let out = &mut rows[q][yy * rww..(yy + 1) * rww];
+            for (k, &pk) in p.iter().enumerate() {
+                for (o, &v) in out.iter_mut().zip(&pad[k..k + rww]) {
+                    *o += pk * v;
                 }
-            }
-            for (q, a) in acc.iter().enumerate() {
-                rows[q][yy * rww + xx] = *a;
             }
         }
     }
-    // 2. Column passes → 7 responses → (C2, C3) over the coefficient window.
+    // 2. Column passes → 7 responses → (C2, C3) over the coefficient window (same columns as
+    //    the row window).
     let (cww, cwh) = (cw.w(), cw.h());
+    debug_assert_eq!((cw.x0, cww), (rw.x0, rww));
     let mut c2 = vec![0.0f64; cww * cwh];
     let mut c3 = vec![0.0f64; cww * cwh];
-    let row_at = |q: usize, x: i64, y: i64| rows[q][((clampy(y) - rw.y0) as usize) * rww + (x - rw.x0) as usize];
+    let mut acc = vec![vec![0.0f64; cww]; 7];
+    // (row piece, column piece) for G2a, G2b, G2c, H2a, H2b, H2c, H2d.
+    let pairs: [(usize, &[f64]); 7] = [
+        (2, &basis.g0),
+        (1, &basis.g1),
+        (0, &basis.g2),
+        (4, &basis.g0),
+        (3, &basis.g1),
+        (1, &basis.h1),
+        (0, &basis.h3),
+    ];
     for yy in 0..cwh {
         let y = cw.y0 + yy as i64;
-        for xx in 0..cww {
-            let x = cw.x0 + xx as i64;
-            // (row piece, column piece) for G2a, G2b, G2c, H2a, H2b, H2c, H2d.
-            let mut s = [0.0f64; 7];
-            for k in 0..(2 * r + 1) {
-                let yk = y + k - r;
-                let ku = k as usize;
-                let (r0, r1, r2, rh1, rh3) =
-                    (row_at(0, x, yk), row_at(1, x, yk), row_at(2, x, yk), row_at(3, x, yk), row_at(4, x, yk));
-                s[0] += r2 * basis.g0[ku];
-                s[1] += r1 * basis.g1[ku];
-                s[2] += r0 * basis.g2[ku];
-                s[3] += rh3 * basis.g0[ku];
-                s[4] += rh1 * basis.g1[ku];
-                s[5] += r1 * basis.h1[ku];
-                s[6] += r0 * basis.h3[ku];
+        for a in acc.iter_mut() {
+            a.iter_mut().for_each(|v| *v = 0.0);
+        }
+        for k in 0..taps {
+            let ry = (clampy(y + k as i64 - r) - rw.y0) as usize;
+            for (a, &(q, col)) in acc.iter_mut().zip(&pairs) {
+                let src = &rows[q][ry * rww..(ry + 1) * rww];
+                let ck = col[k];
+                for (o, &v) in a.iter_mut().zip(src) {
+                    *o += v * ck;
+                }
             }
-            let g = [G2_NORM * s[0], 2.0 * G2_NORM * s[1], G2_NORM * s[2]];
-            let hh = [H2_NORM * s[3], H2_NORM * s[4], H2_NORM * s[5], H2_NORM * s[6]];
+        }
+        for xx in 0..cww {
+            let g = [G2_NORM * acc[0][xx], 2.0 * G2_NORM * acc[1][xx], G2_NORM * acc[2][xx]];
+            let hh = [H2_NORM * acc[3][xx], H2_NORM * acc[4][xx], H2_NORM * acc[5][xx], H2_NORM * acc[6][xx]];
             let (a, b) = oriented_energy(g, hh);
             c2[yy * cww + xx] = a;
             c3[yy * cww + xx] = b;
@@ -188,30 +201,32 @@ fn orientation_window(img: &ImageF32, out: Rect, o: &AngleOptions) -> (Vec<f32>,
     }
     // 3. Gaussian blur of C2, C3 (separable, clamped at the image border) on the output window.
     let (ow, oh) = (out.w(), out.h());
+    let nb = bk.len();
     let blur = |c: &[f64]| -> Vec<f64> {
         // Along x for the output columns over every coefficient row, then along y.
         let mut tmp = vec![0.0f64; ow * cwh];
+        let mut pad = vec![0.0f64; ow + nb - 1];
         for yy in 0..cwh {
-            for xx in 0..ow {
-                let x = out.x0 + xx as i64;
-                let mut a = 0.0;
-                for (k, wk) in bk.iter().enumerate() {
-                    let xs = clampx(x + k as i64 - rb);
-                    a += wk * c[yy * cww + (xs - cw.x0) as usize];
+            for (j, v) in pad.iter_mut().enumerate() {
+                let xs = clampx(out.x0 + j as i64 - rb);
+                *v = c[yy * cww + (xs - cw.x0) as usize];
+            }
+            let o = &mut tmp[yy * ow..(yy + 1) * ow];
+            for (k, wk) in bk.iter().enumerate() {
+                for (t, &v) in o.iter_mut().zip(&pad[k..k + ow]) {
+                    *t += wk * v;
                 }
-                tmp[yy * ow + xx] = a;
             }
         }
         let mut res = vec![0.0f64; ow * oh];
         for yy in 0..oh {
             let y = out.y0 + yy as i64;
-            for xx in 0..ow {
-                let mut a = 0.0;
-                for (k, wk) in bk.iter().enumerate() {
-                    let ys = clampy(y + k as i64 - rb);
-                    a += wk * tmp[((ys - cw.y0) as usize) * ow + xx];
+            let o = &mut res[yy * ow..(yy + 1) * ow];
+            for (k, wk) in bk.iter().enumerate() {
+                let ys = (clampy(y + k as i64 - rb) - cw.y0) as usize;
+                for (t, &v) in o.iter_mut().zip(&tmp[ys * ow..(ys + 1) * ow]) {
+                    *t += wk * v;
                 }
-                res[yy * ow + xx] = a;
             }
         }
         res

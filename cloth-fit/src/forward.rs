@@ -253,6 +253,13 @@ pub fn material(p: &FabricParams, rho: f64, alpha: f64) -> Material {
     }
 }
 
+fn kind_of(i: Integrator) -> IntegratorKind {
+    match i {
+        Integrator::BackwardEuler => IntegratorKind::BackwardEuler,
+        Integrator::Bdf2 => IntegratorKind::Bdf2,
+    }
+}
+
 fn sim_err(t: f64) -> impl Fn(shells::Error) -> SimError {
     move |e| match e {
         shells::Error::BadParameter(_) | shells::Error::NonFinite(_) => SimError::Setup(e.to_string()),
@@ -335,11 +342,7 @@ impl ShellsForward {
         let mut drag = DragForce::new(p.drag, faces.clone());
         drag.implicit = opts.implicit_drag;
         let drag = Arc::new(drag);
-        let kind = match opts.integrator {
-            Integrator::BackwardEuler => IntegratorKind::BackwardEuler,
-            Integrator::Bdf2 => IntegratorKind::Bdf2,
-        };
-        let integrator = IntegratorSettings { kind, ..Default::default() };
+        let integrator = IntegratorSettings { kind: kind_of(opts.integrator), ..Default::default() };
         let effects = Effects { gravity: Some(rig.gravity()), custom: vec![drag], ..Default::default() };
         let settle_effects = Effects { custom: vec![settle_drag], ..effects.clone() };
         let [c0, c1] = mesh.corners;
@@ -380,7 +383,25 @@ impl ShellsForward {
         let n_max = (e.settle.max_s / dt).round().max(n_min as f64) as usize;
         let mut steps = 0usize;
         let mut settled = false;
-        while steps < n_max {
+        let qs = e.settle.quasi_static_steps;
+        let at_rest = |sim: &mut ShellSim, t: f64| -> Result<(), SimError> {
+            let st = sim.state().clone();
+            let v = vec![Vec3::zeros(); st.v.len()];
+            sim.set_state(ShellState { v, ..st }).map_err(sim_err(t))
+        };
+        if qs > 0 {
+            // Quasi-static continuation: each step from rest, backward Euler.
+            sim.settings_mut().kind = IntegratorKind::BackwardEuler;
+            let h = e.settle.move_s.max(1e-3) / qs as f64;
+            for _ in 0..qs {
+                let t = sim.state().t + h;
+                sim.step(h).map_err(sim_err(t))?;
+                at_rest(&mut sim, t)?;
+                steps += 1;
+            }
+            check(&sim.state().q, sim.state().t)?;
+        }
+        while qs == 0 && steps < n_max {
             let t = (steps + 1) as f64 * dt;
             sim.step(dt).map_err(sim_err(t))?;
             steps += 1;
@@ -393,7 +414,22 @@ impl ShellsForward {
             }
         }
         // Quasi-static relaxation to the equilibrium (backward Euler, large steps), then rest.
-        if e.settle.relax_steps > 0 {
+        if qs > 0 {
+            // From rest every step, until no vertex moves more than the tolerance.
+            for _ in 0..e.settle.relax_steps {
+                let q0 = sim.state().q.clone();
+                let t = sim.state().t + e.settle.relax_dt;
+                sim.step(e.settle.relax_dt).map_err(sim_err(t))?;
+                at_rest(&mut sim, t)?;
+                steps += 1;
+                let moved: Vec<f64> = q0.iter().zip(&sim.state().q).map(|(a, b)| (a - b).norm()).collect();
+                if geom_core::stats::max(&moved) <= e.settle.relax_tol_m {
+                    settled = true;
+                    break;
+                }
+            }
+            sim.settings_mut().kind = kind_of(opts.integrator);
+        } else if e.settle.relax_steps > 0 {
             let kind = sim.settings_mut().kind;
             sim.settings_mut().kind = IntegratorKind::BackwardEuler;
             for k in 0..e.settle.relax_steps {
@@ -401,9 +437,8 @@ impl ShellsForward {
                 sim.step(e.settle.relax_dt).map_err(sim_err(t))?;
             }
             sim.settings_mut().kind = kind;
-            let st = sim.state().clone();
-            let v = vec![Vec3::zeros(); st.v.len()];
-            sim.set_state(ShellState { v, ..st }).map_err(sim_err(st.t))?;
+            let t = sim.state().t;
+            at_rest(&mut sim, t)?;
             steps += e.settle.relax_steps;
         }
         let settle_s = sim.state().t;

@@ -53,6 +53,8 @@ fn static_test_tiny() {
     // damping: the paper's finding (damping variability > 20 %) holds by construction.
     let dv = r.get_f64("static_damping_variability_min");
     assert!(dv > 0.2, "static damping variability {dv}");
+    // ... because E does not move at all when a damping coefficient does.
+    assert_eq!(r.get_f64("static_damping_max_de"), 0.0, "E changed with the fabric's damping");
 }
 
 #[test]
