@@ -41,7 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         for k in 0..repeats {
             let obj = Objective::new(&targets, &fwd, &space, &setup)?;
             let p = truth.with(ParamId::Bend, truth.bend * (1.0 + 0.1 * k as f64));
-            let (mut r, _, cpu) = cloth_fit::cpu_time::timed(|| obj.eval_params(&[p]));
+            let (mut r, _, cpu) = geom_core::clock::timed(|| obj.eval_params(&[p]));
             let r = r.remove(0);
             println!(
                 "{name}: E = {:.4}  wall {:.3} s  CPU {cpu:.2} s  (sim {:.3}, render {:.3}, filter {:.3}, metric {:.3} summed over frames)",

@@ -34,7 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         trials: TrialPolicy::PerTrialThenSelect,
         variability: None,
     };
-    let (r, wall, cpu) = cloth_fit::cpu_time::timed(|| fit(&t, &ShellsForward, &sp, &s, &o, &mut |_, _| {}));
+    let (r, wall, cpu) = geom_core::clock::timed(|| fit(&t, &ShellsForward, &sp, &s, &o, &mut |_, _| {}));
     let r = r?;
     let (eb, es) = ((r.params.bend / truth.bend).ln().abs(), (r.params.stretch / truth.stretch).ln().abs());
     let tol = 0.15f64.ln_1p();

@@ -23,7 +23,6 @@ pub mod angle;
 pub mod anneal;
 pub mod camera;
 pub mod coarse;
-pub mod cpu_time;
 pub mod dlt;
 pub mod drag;
 pub mod error;

@@ -92,7 +92,7 @@ pub fn median_eval_time(obj: &Objective, truth: FabricParams) -> (f64, f64) {
     let (mut walls, mut cpus) = (Vec::new(), Vec::new());
     for k in 1..=3 {
         let p = truth.with(ParamId::Bend, (1.0 + 0.1 * k as f64) * truth.bend);
-        let (_, wall, cpu) = crate::cpu_time::timed(|| obj.eval_params(&[p]));
+        let (_, wall, cpu) = geom_core::clock::timed(|| obj.eval_params(&[p]));
         walls.push(wall);
         cpus.push(cpu);
     }

@@ -33,9 +33,9 @@ use shells::metrics::Sanity;
 use shells::scene::SceneIntegrator;
 use shells::{CollisionSettings, Effects, Material, Obstacle, ShellSceneDesc, ShellSim, VertexConstraint};
 
-use super::cpu_clock::process_cpu_seconds;
 use crate::error::{Result, WrinkleError};
 use crate::frames::RestMesh;
+use geom_core::clock::process_cpu_s as process_cpu_seconds;
 
 fn driver(e: impl std::fmt::Display) -> WrinkleError {
     WrinkleError::Driver(e.to_string())

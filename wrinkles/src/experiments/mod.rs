@@ -8,9 +8,7 @@
 //! - `vs_fine` (feature `shells`): W4, coarse `shells` cloth + wrinkles against fine `shells`
 //!   cloth (`vs-fine`); `sleeve` (feature `shells`): W3 on a `shells` sleeve (`sleeve`);
 //!   `cloth` builds and steps those simulations.
-//! - [`cpu_clock`]: the process CPU time the cost figures use.
 
-pub mod cpu_clock;
 pub mod four_stage;
 pub mod precompute_cost;
 pub mod realtime_small;

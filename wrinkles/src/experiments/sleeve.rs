@@ -32,7 +32,6 @@ use geom_core::stats::{mean, nan_max};
 use serde::Deserialize;
 
 use super::cloth::{Cloth, ClothModel, Sleeve};
-use super::cpu_clock::timed;
 use crate::animator::{FrameModulation, HMax, ModulationOptions, WrinkleAnimator};
 use crate::blend::BlendOptions;
 use crate::coeffs::{precompute, PrecomputeOptions};
@@ -43,6 +42,7 @@ use crate::modulation::ModulationMode;
 use crate::pattern::{Normalization, PatternOptions, PatternSource, Procedural, WrinklePattern};
 use crate::presets::folds;
 use crate::smoothing::{Smoothing, VertexWeights};
+use geom_core::clock::timed;
 
 /// The scene's `params` block.
 #[derive(Clone, Debug, Deserialize)]

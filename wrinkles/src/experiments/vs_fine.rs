@@ -43,7 +43,6 @@ use geom_core::stats::mean;
 use serde::Deserialize;
 
 use super::cloth::{Cloth, ClothModel, Curtain};
-use super::cpu_clock::timed;
 use crate::animator::{HMax, MapTransform, ModulationOptions, WrinkleAnimator};
 use crate::coeffs::{precompute, PrecomputeOptions};
 use crate::displaced::Refinement;
@@ -55,6 +54,7 @@ use crate::metrics::{
 use crate::modulation::{ModulationMode, StrainMeasure};
 use crate::presets::sinusoid;
 use crate::smoothing::{Smoothing, VertexWeights};
+use geom_core::clock::timed;
 
 /// The scene's `params` block.
 #[derive(Clone, Debug, Deserialize)]
