@@ -90,7 +90,7 @@ fn rings(lambda: f64, slope: f64) -> Result<WrinklePattern> {
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     let mut s = p.sleeve.clone();
     let k = p.time_scale.as_ref().map_or(1.0, |b| b.get(size));
-    if !(k > 0.0) || p.level == 0 || !(p.roi_v[0] < p.roi_v[1]) {
+    if k.is_nan() || k <= 0.0 || p.level == 0 || p.roi_v[0].partial_cmp(&p.roi_v[1]) != Some(std::cmp::Ordering::Less) {
         return Err(WrinkleError::InvalidOption(format!(
             "time_scale must be > 0 (got {k}), level ≥ 1, roi_v increasing (got {:?})",
             p.roi_v

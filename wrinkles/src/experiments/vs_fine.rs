@@ -140,7 +140,7 @@ fn check(p: &Params, c: &Curtain, fine: &[u32], frames: usize) -> Result<()> {
         || p.level == 0
         || p.intersections_every == 0
         || p.fine.integrator.fps != p.coarse.integrator.fps
-        || p.coarse_noise_m.is_some_and(|n| !(n >= 0.0))
+        || p.coarse_noise_m.is_some_and(|n| n.is_nan() || n < 0.0)
     {
         return Err(bad(
             "sample_dx, sigma0, slope, max_slope, flat_at_rest_scale must be > 0, level and intersections_every ≥ 1, \

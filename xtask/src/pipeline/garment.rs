@@ -125,7 +125,7 @@ pub fn build(src: &GarmentSource, c: &Character, gap: f64, resolve: impl Fn(&Pat
         .enumerate()
         .map(|(i, p)| (q.signed_distance(p), i))
         .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
-    if !(worst > gap) {
+    if worst.is_nan() || worst <= gap {
         return Err(Error::Run(format!(
             "{name}: vertex {v} starts {} the body (signed distance {worst:.4} m; the garment must start at least {gap} m outside it)",
             if worst < 0.0 { "inside" } else { "too close to" }

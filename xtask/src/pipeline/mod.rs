@@ -79,7 +79,13 @@ pub fn register(v: &mut Vec<Runner>) {
 
 /// Runs the pipeline at `size` (paths resolved against the scene file of `ctx`).
 pub fn run(ctx: &RunCtx, p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
-    if !(p.fps > 0.0 && p.fps.is_finite()) || p.substeps == 0 || p.every == 0 || !(p.thickness > 0.0) {
+    if !p.fps.is_finite()
+        || p.fps <= 0.0
+        || p.substeps == 0
+        || p.every == 0
+        || p.thickness.is_nan()
+        || p.thickness <= 0.0
+    {
         return Err(bad(
             ctx,
             format!(
