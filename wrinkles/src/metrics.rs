@@ -302,11 +302,14 @@ mod tests {
     }
 
     /// A sinusoidal height field along u: λ̂ equals λ, the orientation is 0° (wave vector along
-    /// u), the RMS is A/√2, and the middle row crosses zero twice per wavelength.
+    /// u), the RMS is A/√2, and the middle row crosses zero twice per wavelength. λ̂ comes from
+    /// finite-difference gradients, which overestimate λ by kh/sin(kh) (2.6 % at h = λ/16,
+    /// measured 3.2 % with the one-sided edges); at h = λ/64 the bias is 0.16 %, so the 1 %
+    /// tolerance tests the estimator, not its grid.
     #[test]
     fn fold_stats_of_a_sinusoid() {
         let lambda = 0.05;
-        let g = MaterialGrid::covering(Pt2::new(0.0, 0.0), Pt2::new(0.5, 0.2), lambda / 16.0);
+        let g = MaterialGrid::covering(Pt2::new(0.0, 0.0), Pt2::new(0.5, 0.2), lambda / 64.0);
         let d: Vec<f64> =
             g.points().iter().map(|p| 0.01 * (2.0 * std::f64::consts::PI * p.x / lambda + 0.3).sin()).collect();
         let s = fold_stats(&d, &g, Pt2::new(0.0, 0.0), Pt2::new(0.5, 0.2));
