@@ -52,31 +52,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     for o in &built.desc.effects.obstacles {
         match &o.shape {
-            ObstacleShape::Sphere { center, radius } => {
-                let m = geom_core::procedural::icosphere(*radius, 3)?;
-                let p: Vec<Pt3> = m.positions.iter().map(|q| q + center.coords).collect();
-                add(&p, &m.faces);
-            }
-            ObstacleShape::Capsule { a, b, radius } => {
-                let t = geom_core::procedural::tube(&geom_core::procedural::TubeSpec {
-                    radius: *radius,
-                    length: (b - a).norm(),
-                    around: 16,
-                    along: 1,
-                    start: *a,
-                    axis: b - a,
-                    caps: geom_core::procedural::Caps::Fan,
-                })?;
-                let m = t.triangulate_fan()?.0;
-                add(&m.positions, &m.faces);
-            }
-            ObstacleShape::Mesh { verts, tris } => add(verts, tris),
             ObstacleShape::Plane { normal, offset } => {
                 let n = normal.normalize();
                 let u = n.cross(&if n.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() }).normalize() * 1.5;
                 let v = n.cross(&u);
                 let c = Pt3::from(n * *offset);
                 add(&[c - u - v, c + u - v, c + u + v, c - u + v], &[[0, 2, 1], [0, 3, 2], [0, 1, 2], [0, 2, 3]]);
+            }
+            shape => {
+                if let Some((p, f)) = shape.surface_mesh()? {
+                    add(&p, &f);
+                }
             }
         }
     }

@@ -33,6 +33,7 @@ pub mod loads;
 pub mod material;
 pub mod mesh;
 pub mod metrics;
+pub mod obstacle_mesh;
 pub mod presets;
 pub mod reference;
 pub mod scene;

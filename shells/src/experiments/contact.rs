@@ -78,28 +78,10 @@ pub fn record_context(sim: &ShellSim, shell: &ShellScene, rec: &mut dyn Recorder
                 SceneItem::Ground { y: offset / normal.y }
             }
             ObstacleShape::Plane { .. } => continue,
-            ObstacleShape::Sphere { center, radius } => {
-                let m = geom_core::procedural::icosphere(*radius, 3)?;
-                let positions = m.positions.iter().map(|p| p + center.coords).collect();
-                SceneItem::Mesh { name, positions, faces: m.faces.clone() }
-            }
-            ObstacleShape::Capsule { a, b, radius } => {
-                let axis = b - a;
-                let t = geom_core::procedural::tube(&geom_core::procedural::TubeSpec {
-                    radius: *radius,
-                    length: axis.norm(),
-                    around: 16,
-                    along: 1,
-                    start: *a,
-                    axis,
-                    caps: geom_core::procedural::Caps::Fan,
-                })?;
-                let m = t.triangulate_fan()?.0;
-                SceneItem::Mesh { name, positions: m.positions.clone(), faces: m.faces.clone() }
-            }
-            ObstacleShape::Mesh { verts, tris } => {
-                SceneItem::Mesh { name, positions: verts.clone(), faces: tris.clone() }
-            }
+            shape => match shape.surface_mesh()? {
+                Some((positions, faces)) => SceneItem::Mesh { name, positions, faces },
+                None => continue,
+            },
         };
         rec.scene(&item)?;
     }

@@ -136,18 +136,10 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     );
     rec.scene(&SceneItem::FrameRate { fps: cl.fps })?;
     for o in &cl.sim.effects().obstacles {
-        if let shells::ObstacleShape::Capsule { a, b, radius } = &o.shape {
-            let t = geom_core::procedural::tube(&geom_core::procedural::TubeSpec {
-                radius: *radius,
-                length: (b - a).norm(),
-                around: 16,
-                along: 1,
-                start: *a,
-                axis: b - a,
-                caps: geom_core::procedural::Caps::Fan,
-            })?;
-            let m = t.triangulate_fan()?.0;
-            rec.scene(&SceneItem::Mesh { name: "arm".into(), positions: m.positions.clone(), faces: m.faces.clone() })?;
+        if let (shells::ObstacleShape::Capsule { .. }, Some((positions, faces))) =
+            (&o.shape, o.shape.surface_mesh().map_err(|e| WrinkleError::Driver(e.to_string()))?)
+        {
+            rec.scene(&SceneItem::Mesh { name: "arm".into(), positions, faces })?;
         }
     }
     let mut pinned: Vec<u32> = cl.sim.free_dofs().pinned.iter().chain(&cl.sim.free_dofs().kinematic).copied().collect();
