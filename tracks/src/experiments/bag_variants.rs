@@ -51,8 +51,11 @@ const SCENE: &str = "tracks/bag-variants";
 pub struct Params {
     /// Run settings, as in `tracks/bag`.
     pub run: PairParams,
-    /// The variants run with `--quick` (and at the tiny size); default and full run all.
+    /// The variants run with `--quick` (and at the tiny size).
     pub quick_variants: Vec<String>,
+    /// The variants run in default mode (absent: all); `--full` runs all.
+    #[serde(default)]
+    pub default_variants: Option<Vec<String>>,
     /// `accordion`: relative amplitude and wavelength (m) of r ← r(1 + a sin(2πy/λ)).
     pub accordion: (f64, f64),
     /// `ribbon`: relative amplitude and lobe count of r ← r(1 + a|sin(nφ)|).
@@ -141,7 +144,7 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     p.validate()?;
     let base = bag_setup(&ShellOptions { substeps: 1, self_collision: false, contact: p.run.contact })?;
     let all = variants(p, &base.tracked_rest.positions, &base.tracked_rest.faces);
-    let chosen = select(all, &p.quick_variants, size, SCENE)?;
+    let chosen = select(all, &p.quick_variants, p.default_variants.as_deref(), size, SCENE)?;
     let (runs, duration) = run_variants(&p.run, size, chosen, true, &|o| bag_setup(o), rec)?;
     let mut r = Report::default();
     rec.table(

@@ -59,8 +59,11 @@ const SCENE: &str = "tracks/box-variants";
 pub struct Params {
     /// Run settings, as in `tracks/box`.
     pub run: PairParams,
-    /// The variants run with `--quick` (and at the tiny size); default and full run all.
+    /// The variants run with `--quick` (and at the tiny size).
     pub quick_variants: Vec<String>,
+    /// The variants run in default mode (absent: all); `--full` runs all.
+    #[serde(default)]
+    pub default_variants: Option<Vec<String>>,
     /// `stiffness` family: bending k_B scales (at Yt × 1); the k_B × 1 run is the elastic base.
     pub kb_scale: Vec<f64>,
     /// `stiffness` family: membrane Yt scales (at k_B × 1); a scale of 1 is the `kb_1` run.
@@ -156,7 +159,7 @@ pub fn variants(p: &Params) -> Vec<Variant> {
 /// Runs the variants of the size and compares them.
 pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     p.validate()?;
-    let chosen = select(variants(p), &p.quick_variants, size, SCENE)?;
+    let chosen = select(variants(p), &p.quick_variants, p.default_variants.as_deref(), size, SCENE)?;
     let (runs, duration) = run_variants(&p.run, size, chosen, false, &|o| box_setup(o), rec)?;
     let fps = 30.0;
     let mut r = Report::default();
@@ -337,7 +340,7 @@ mod tests {
         for n in ["kb_0_1", "kb_10", "yt_0_3", "plastic_3_eta_p0_3", "plastic_3_eta_m0_3", "beta_0_002_rho_2"] {
             assert!(names.iter().any(|x| x == n), "{n} missing from {names:?}");
         }
-        let quick = select(variants(&p), &p.quick_variants, Size::Quick, "t").expect("quick names exist");
+        let quick = select(variants(&p), &p.quick_variants, None, Size::Quick, "t").expect("quick names exist");
         assert_eq!(quick.len(), p.quick_variants.len());
     }
 

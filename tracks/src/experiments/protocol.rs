@@ -46,15 +46,15 @@ pub struct PairParams {
     /// The contact model of the fine shell (default IPC; `Bridson` = the seed's filter).
     #[serde(default)]
     pub contact: ContactMethod,
-    /// Also run the untracked twin (default true). Off, the untracked keys are absent (NaN
-    /// deviations): for tracked-only figures when the twin's cost does not fit (a crumpled
-    /// untracked Xavier costs 1.4–6.6 s per step on the ground).
+    /// Also run the untracked twin, per run size (default true for every size). Off, the
+    /// untracked keys are absent (NaN deviations): for tracked-only figures when the twin's cost
+    /// does not fit (a crumpled untracked Xavier costs 1.4–6.6 s per step on the ground).
     #[serde(default = "yes")]
-    pub untracked: bool,
+    pub untracked: BySize<bool>,
 }
 
-fn yes() -> bool {
-    true
+fn yes() -> BySize<bool> {
+    BySize::Same(true)
 }
 
 impl PairParams {
@@ -648,7 +648,7 @@ pub fn run_standard_with(
     let o = PairOpts {
         frames,
         obj_every: p.obj_every,
-        untracked: p.untracked,
+        untracked: p.untracked.get(size),
         track: p.track(),
         intersections,
         anchors: None,

@@ -54,19 +54,28 @@ impl VariantRun {
     }
 }
 
-/// The variants of this run size: all in default / full, the named ones in quick and tiny
-/// (unknown names are an error listing the known ones).
-pub fn select(all: Vec<Variant>, quick: &[String], size: Size, scene: &str) -> Result<Vec<Variant>> {
-    if !matches!(size, Size::Quick | Size::Tiny) {
-        return Ok(all);
-    }
-    for q in quick {
+/// The variants of this run size: the `quick` names in quick and tiny, the `default` names in
+/// default mode when given (else all), all in full (unknown names are an error listing the known
+/// ones).
+pub fn select(
+    all: Vec<Variant>,
+    quick: &[String],
+    default: Option<&[String]>,
+    size: Size,
+    scene: &str,
+) -> Result<Vec<Variant>> {
+    let (names, field) = match (size, default) {
+        (Size::Quick | Size::Tiny, _) => (quick, "quick_variants"),
+        (Size::Default, Some(d)) => (d, "default_variants"),
+        _ => return Ok(all),
+    };
+    for q in names {
         if !all.iter().any(|v| &v.name == q) {
             let known: Vec<&str> = all.iter().map(|v| v.name.as_str()).collect();
-            return Err(bad(scene, format!("quick_variants: unknown variant `{q}`; known: {}", known.join(", "))));
+            return Err(bad(scene, format!("{field}: unknown variant `{q}`; known: {}", known.join(", "))));
         }
     }
-    Ok(all.into_iter().filter(|v| quick.contains(&v.name)).collect())
+    Ok(all.into_iter().filter(|v| names.contains(&v.name)).collect())
 }
 
 /// Runs `variants` tracked-only with `make_setup(shell options)` as the base scene (tables and
@@ -193,14 +202,22 @@ mod tests {
         assert_eq!(num_key(-0.3), "m0_3");
     }
 
-    /// Unknown quick names are an error listing the known ones; default size runs all.
+    /// Unknown names are an error listing the known ones; default size runs the default names when
+    /// given, else all; full runs all.
     #[test]
     fn selection() {
         let mk = |n: &str| Variant { name: n.into(), family: "x", edit: Box::new(|_| {}) };
         let all = || vec![mk("a"), mk("b"), mk("c")];
-        assert_eq!(select(all(), &["b".into()], Size::Quick, "s").unwrap().len(), 1);
-        assert_eq!(select(all(), &["b".into()], Size::Default, "s").unwrap().len(), 3);
-        let e = select(all(), &["z".into()], Size::Tiny, "s").err().expect("unknown name rejected");
+        assert_eq!(select(all(), &["b".into()], None, Size::Quick, "s").unwrap().len(), 1);
+        assert_eq!(select(all(), &["b".into()], None, Size::Default, "s").unwrap().len(), 3);
+        let d = ["a".to_string(), "c".to_string()];
+        let named: Vec<String> =
+            select(all(), &["b".into()], Some(&d), Size::Default, "s").unwrap().into_iter().map(|v| v.name).collect();
+        assert_eq!(named, ["a", "c"]);
+        assert_eq!(select(all(), &["b".into()], Some(&d), Size::Full, "s").unwrap().len(), 3);
+        let e = select(all(), &["z".into()], None, Size::Tiny, "s").err().expect("unknown name rejected");
         assert!(e.to_string().contains("`z`") && e.to_string().contains("a, b, c"), "{e}");
+        let e = select(all(), &[], Some(&["y".to_string()]), Size::Default, "s").err().expect("unknown default name");
+        assert!(e.to_string().contains("default_variants: unknown variant `y`"), "{e}");
     }
 }
