@@ -57,15 +57,34 @@ fn mouse_paths_pc3() {
     assert!(r.get_f64("fast_d_per_frame") > r.get_f64("d_per_frame_mean"), "the 6 m/s stroke is explained worse");
 }
 
+fn real_data(name: &str) -> Report {
+    let mut p: real_data::Params = load_params(&scene(name)).unwrap();
+    p.resolve_paths(&root().join("scenes/perf-control"));
+    tests::assert_thread_independent(name, || real_data::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap())
+}
+
 #[test]
 fn real_data_pc6() {
-    let mut p: real_data::Params = load_params(&scene("real-data")).unwrap();
-    p.resolve_paths(&root().join("scenes/perf-control"));
-    let r = tests::assert_thread_independent("real-data", || {
-        real_data::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap()
-    });
+    let r = real_data("real-data");
     assert!(r.get_f64("segments_detected") > 10.0);
-    assert!(r.get_f64("mid_rms_m").is_finite());
+    for key in ["mid_rms_m", "phase_agreement", "stride_ratio", "skate_cm_s"] {
+        assert!(r.get_f64(key).is_finite(), "{key} = {}", r.get_f64(key));
+    }
+    // The converter's T-pose (frame 0) is far from the clips' median pose and is dropped.
+    for clip in ["01_01", "01_03"] {
+        assert!(r.get_f64(&format!("setup_dropped_frames_{clip}")) >= 1.0, "{clip}");
+        assert!(r.get_f64(&format!("setup_frame0_pose_dist_m_{clip}")) > 0.3, "{clip}");
+    }
+}
+
+#[test]
+fn real_data_cross_clip_pc6() {
+    let r = real_data("real-data-cross-clip");
+    assert!(r.get_f64("segments_detected") > 10.0);
+    assert!(r.get_f64("setup_dropped_frames_01_03") >= 1.0);
+    for key in ["mid_rms_m", "heading_rms_deg", "phase_agreement", "stride_ratio", "skate_cm_s"] {
+        assert!(r.get_f64(key).is_finite(), "{key} = {}", r.get_f64(key));
+    }
 }
 
 #[test]
