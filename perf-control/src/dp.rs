@@ -481,3 +481,30 @@ pub fn score_chain(db: &MappingDb, x: &PointTrack, chain: &[(u32, i64, i64)], p:
     it.score = it.d_total + p.k * it.c_total;
     Some(it)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::walk_take;
+
+    /// The DP's cell evaluations and relaxations run in parallel over columns: the scores,
+    /// chains and work counters are bitwise identical with 1 and 2 rayon threads, exact and with
+    /// the beam.
+    #[test]
+    fn parallel_dp_is_thread_independent() {
+        let db = MappingDb::from_takes(vec![walk_take(5, 12.0, 30.0)], 10.0).unwrap();
+        let x = walk_take(6, 8.0, 30.0).control.downsample(3);
+        for beam in [None, Some(0.3)] {
+            let p = DpParams { beam, ..DpParams::default() };
+            let run = |n: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+                pool.install(|| interpret(&db, &x, &p).unwrap())
+            };
+            let (a, b) = (run(1), run(2));
+            assert_eq!(a.score.to_bits(), b.score.to_bits(), "beam {beam:?}");
+            assert_eq!(a.segments, b.segments);
+            let counters = |s: &DpStats| (s.cells_expanded, s.cells_evaluated, s.relaxations);
+            assert_eq!(counters(&a.stats), counters(&b.stats));
+        }
+    }
+}

@@ -142,3 +142,36 @@ pub fn trim_setup(m: Motion, rule: &SetupRule) -> Result<(Motion, Settled)> {
     let s = settled_start(&m, rule)?;
     Ok((m.slice(s.first, m.len()), s))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::walk_motion;
+
+    /// A synthesised walk is settled from its first frame; clearing the contacts of its first
+    /// frames (unsupported, like the CMU clips' frames 0 and 1) drops exactly those; bad
+    /// thresholds and a clip without contacts are typed errors.
+    #[test]
+    fn rule_drops_unsupported_start_frames() {
+        let m = walk_motion(3, 4.0, 30.0);
+        let rule = SetupRule::default();
+        let s = settled_start(&m, &rule).unwrap();
+        assert_eq!(s.first, 0);
+        assert!(s.pose_dist_m.iter().all(|d| d.is_finite()));
+        let mut m2 = m.clone();
+        for f in 0..3 {
+            m2.labels.contacts[f] = 0;
+        }
+        assert_eq!(settled_start(&m2, &rule).unwrap().first, 3);
+        let (t, s2) = trim_setup(m2, &rule).unwrap();
+        assert_eq!((t.len(), s2.first), (m.len() - 3, 3));
+        // A tolerance below every frame's distance finds no settled run.
+        assert!(settled_start(&m, &SetupRule { hold_s: 0.2, pose_tol_m: 1e-9 }).is_err());
+        for bad in [SetupRule { hold_s: f64::NAN, pose_tol_m: 0.3 }, SetupRule { hold_s: 0.2, pose_tol_m: 0.0 }] {
+            assert!(matches!(settled_start(&m, &bad), Err(PcError::BadParameter { .. })));
+        }
+        let mut m3 = m.clone();
+        m3.labels.contacts.clear();
+        assert!(matches!(settled_start(&m3, &rule), Err(PcError::BadParameter { .. })));
+    }
+}
