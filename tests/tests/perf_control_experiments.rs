@@ -32,6 +32,12 @@ fn walk_pc1() {
         assert!(check(&r, key), "{key} = {}", r.get_f64(key));
     }
     assert!(r.get_f64("db_instances") <= r.get_f64("db_instances_before"));
+    // The streaming DP beside the offline one: an agreement in [0, 1], never a better score, a
+    // measured latency of at least the lag.
+    let agree = r.get_f64("streaming_label_agreement");
+    assert!((0.0..=1.0).contains(&agree), "streaming agreement {agree}");
+    assert!(r.get_f64("streaming_score_excess_rel") >= -1e-12);
+    assert!(r.get_f64("streaming_latency_s") >= r.get_f64("streaming_lag_s") - 1e-12);
 }
 
 #[test]
