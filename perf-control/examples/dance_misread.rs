@@ -15,6 +15,11 @@ use perf_control::experiments::{dance, load_params};
 use perf_control::presets::dance_database;
 use perf_control::{interpret, score_chain};
 
+/// A chain as (instance, start, end) per segment.
+type Chain = Vec<(u32, i64, i64)>;
+/// The best substitution so far: score, `ΣD`, `ΣC`, `C` at the run's junctions, the chain.
+type Best = (f64, f64, f64, Vec<f64>, Chain);
+
 fn main() -> perf_control::Result<()> {
     let p: dance::Params = load_params(std::path::Path::new("scenes/perf-control/dance.ron"))?;
     let cue: f64 = std::env::args().nth(1).map_or(p.duet.toggle_cue_m, |s| s.parse().expect("cue (m)"));
@@ -51,7 +56,7 @@ fn main() -> perf_control::Result<()> {
             ds.sort_by(|a, b| a.0.total_cmp(&b.0));
             let rank = ds.iter().position(|&(_, n)| db.instances[n as usize].label.dance() == Some(l));
             // Best substitution of the run by right-labelled instances.
-            let mut best: Option<(f64, f64, f64, Vec<f64>, Vec<(u32, i64, i64)>)> = None;
+            let mut best: Option<Best> = None;
             // The whole run of consecutive misread segments from i (each on its own chain segment).
             if i > 0 && out[i - 1] != Some(truth.segments[i - 1].2) {
                 continue;

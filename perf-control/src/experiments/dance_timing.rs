@@ -5,9 +5,10 @@
 //! log-log fit (the exponent, ≈ 1 for a DP linear in the input length) and a linear fit.
 //! The offline DP ([`crate::dp::interpret`]) runs its cell evaluations and relaxations in
 //! parallel over columns on the current rayon pool (size reported as `threads`); the exact run is
-//! repeated on a 1-thread pool (`dp_exact_1thread_s`) for the parallel speed-up
-//! (`dp_parallel_speedup`, wall) and to check that both give the same chain and score bit for bit
-//! (`parallel_bitwise_identical`).
+//! repeated on a 1-thread pool (`dp_exact_1thread_s`, `dp_exact_1thread_cpu_s`) to check that both
+//! give the same chain and score bit for bit (`parallel_bitwise_identical`). The two wall times are
+//! reported side by side but their ratio is no speed-up measurement on a shared machine: with the
+//! global pool also at 1 thread (`RAYON_NUM_THREADS=1`) the same ratio came out 2.2 (README).
 //!
 //! Every time is measured as wall clock (`*_s`, what the checks use) and as the process's CPU time
 //! (`*_cpu_s`, [`geom_core::clock::process_cpu_s`]: every thread's, so with 2 threads the CPU time
@@ -161,7 +162,6 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
     r.timing("dp_exact_cpu_s", exact_cpu);
     r.timing("dp_exact_1thread_s", exact1_s);
     r.timing("dp_exact_1thread_cpu_s", exact1_cpu);
-    r.timing("dp_parallel_speedup", exact1_s / exact_s);
     r.flag("parallel_bitwise_identical", bitwise);
     r.timing("dp_beam_cpu_s", beam_cpu);
     r.timing("refine_cpu_s", refine_cpu);
