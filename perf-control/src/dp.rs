@@ -7,6 +7,7 @@ use crate::db::MappingDb;
 use crate::error::{check_finite, PcError, Result};
 use crate::track::PointTrack;
 use geom_core::math::{Planar, Vec3};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -236,19 +237,26 @@ pub fn interpret(db: &MappingDb, x: &PointTrack, p: &DpParams) -> Result<Interpr
             let cut = beam.map_or(f64::INFINITY, |w| best + w);
             live.extend((0..np).filter(|&c| row[c].is_finite() && row[c] <= cut));
         }
-        // Successor cells starting at s0.
+        // Successor cells starting at s0, evaluated in parallel over columns (each cell by one
+        // task; copied out in column order, so the result does not depend on the thread count).
+        let evals: Vec<Option<CellEval>> = cols
+            .par_iter()
+            .map(|col| {
+                let t = s0 + col.d as i64;
+                if (!p.partial_ends && t > t_len - 1) || excluded(&p.forced, col.inst, s0, t) {
+                    return None;
+                }
+                eval_cell(x, col, s0, wc)
+            })
+            .collect();
         let mut any = false;
-        for (c, col) in cols.iter().enumerate() {
+        for (c, e) in evals.into_iter().enumerate() {
             succ_d[c] = f64::INFINITY;
-            let t = s0 + col.d as i64;
-            if (!p.partial_ends && t > t_len - 1) || excluded(&p.forced, col.inst, s0, t) {
-                continue;
-            }
-            let Some(CellEval { d, alpha, omega, .. }) = eval_cell(x, col, s0, wc) else { continue };
+            let Some(CellEval { d, alpha, omega, .. }) = e else { continue };
             stats.cells_evaluated += 1;
             succ_d[c] = d;
             succ_alpha[c * 2 * kt..(c + 1) * 2 * kt].copy_from_slice(&alpha);
-            let r = (t as usize) % ring;
+            let r = ((s0 + cols[c].d as i64) as usize) % ring;
             tails[(r * np + c) * 2 * kt..(r * np + c + 1) * 2 * kt].copy_from_slice(&omega);
             any = true;
         }
@@ -275,24 +283,41 @@ pub fn interpret(db: &MappingDb, x: &PointTrack, p: &DpParams) -> Result<Interpr
             gemm_relax(&ctx, &live, s0 as usize, p, &mut q, &mut back, &mut stats);
             continue;
         }
-        for &r in &live {
-            stats.cells_expanded += 1;
-            let qr = q[s0 as usize * np + r];
-            let om = &tails[(r_src * np + r) * 2 * kt..(r_src * np + r + 1) * 2 * kt];
-            for (c, col) in cols.iter().enumerate() {
+        // Relaxation, parallel over successor columns: every successor cell `(s0 + d_c, c)` is
+        // written by one task only, which scans the live predecessors in ascending column order
+        // with a strict `<` — the comparisons of the sequential push sweep, in the same order, so
+        // the scores and backpointers are bitwise identical for any thread count.
+        let s0u = s0 as usize;
+        let qlive: Vec<f64> = live.iter().map(|&r| q[s0u * np + r]).collect();
+        let (qr, br) = (&q, &back);
+        let upd: Vec<Option<(f64, u32)>> = (0..np)
+            .into_par_iter()
+            .map(|c| {
                 let dc = succ_d[c];
                 if !dc.is_finite() {
-                    continue;
+                    return None;
                 }
-                stats.relaxations += 1;
+                let cell = (s0u + cols[c].d) * np + c;
+                let (mut best, mut arg) = (qr[cell], br[cell]);
                 let al = &succ_alpha[c * 2 * kt..(c + 1) * 2 * kt];
-                let z = qr + p.k * continuity(om, al, wt, p.continuity_order, p.k_vel) + dc;
-                let cell = (s0 as usize + col.d) * np + c;
-                if z < q[cell] {
-                    q[cell] = z;
-                    back[cell] = r as u32;
+                for (&r, &qv) in live.iter().zip(&qlive) {
+                    let om = &tails[(r_src * np + r) * 2 * kt..(r_src * np + r + 1) * 2 * kt];
+                    let z = qv + p.k * continuity(om, al, wt, p.continuity_order, p.k_vel) + dc;
+                    if z < best {
+                        best = z;
+                        arg = r as u32;
+                    }
                 }
-            }
+                Some((best, arg))
+            })
+            .collect();
+        stats.cells_expanded += live.len() as u64;
+        for (c, u) in upd.into_iter().enumerate() {
+            let Some((best, arg)) = u else { continue };
+            stats.relaxations += live.len() as u64;
+            let cell = (s0u + cols[c].d) * np + c;
+            q[cell] = best;
+            back[cell] = arg;
         }
     }
     // Answer: cells ending at T − 1 (or beyond with partial ends), earliest end, lowest column.
@@ -455,4 +480,31 @@ pub fn score_chain(db: &MappingDb, x: &PointTrack, chain: &[(u32, i64, i64)], p:
     let mut it = finish(db, x, &cols, &pairs, p, 0.0, clock, DpStats::default());
     it.score = it.d_total + p.k * it.c_total;
     Some(it)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::walk_take;
+
+    /// The DP's cell evaluations and relaxations run in parallel over columns: the scores,
+    /// chains and work counters are bitwise identical with 1 and 2 rayon threads, exact and with
+    /// the beam.
+    #[test]
+    fn parallel_dp_is_thread_independent() {
+        let db = MappingDb::from_takes(vec![walk_take(5, 12.0, 30.0)], 10.0).unwrap();
+        let x = walk_take(6, 8.0, 30.0).control.downsample(3);
+        for beam in [None, Some(0.3)] {
+            let p = DpParams { beam, ..DpParams::default() };
+            let run = |n: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(n).build().unwrap();
+                pool.install(|| interpret(&db, &x, &p).unwrap())
+            };
+            let (a, b) = (run(1), run(2));
+            assert_eq!(a.score.to_bits(), b.score.to_bits(), "beam {beam:?}");
+            assert_eq!(a.segments, b.segments);
+            let counters = |s: &DpStats| (s.cells_expanded, s.cells_evaluated, s.relaxations);
+            assert_eq!(counters(&a.stats), counters(&b.stats));
+        }
+    }
 }

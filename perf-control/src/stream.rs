@@ -2,15 +2,18 @@
 //! eqs. 6–7 run online, one input frame at a time, committing the segment that covers frame
 //! `t − lag` as soon as frame `t` has arrived. The output therefore lags the control by exactly
 //! `lag` working frames — the path to live use — and the committed segments always form one chain.
-//! The last segment of the chain traced from frame `t` ends at `t` only because the input stops
-//! there, so it is never committed: when it covers `t − lag`, only the segments before it are
-//! committed and that frame waits (the measured latency, [`Streamed::latency_max_s`], can exceed
-//! the lag by up to one segment).
+//! The decision at frame `t` is the offline DP's answer for an input that stops at `t`, given the
+//! committed prefix: the best chain whose last segment either ends at `t` or, with partial ends,
+//! overhangs it (scored on its samples up to `t`, the `(d+1)/#in-range` scaling of the offline
+//! DP's partial end). That last segment is cut by the end of the data, not by a decision, so it
+//! is never committed: when it covers `t − lag`, only the segments before it are committed and
+//! that frame waits (the measured latency, [`Streamed::latency_max_s`], can exceed the lag by up
+//! to one segment).
 //!
 //! Per new frame `t` the DP computes the row of cells ending at `t` in pull form (cell `(t, c)`
 //! takes the best live predecessor ending at `t − d_c`, ties to the lowest column as in
 //! [`crate::dp::interpret`], the same beam per source row). Then, if frame `f = t − lag` is not yet
-//! committed, the best chain ending at `t` is traced back to the last committed segment and its
+//! committed, the decision's chain is traced back to the last committed segment and its
 //! segments up to the one covering `f` are committed. Committing restricts the DP: every cell
 //! ending before the new frontier is dropped, the frontier row keeps only the committed cell,
 //! start cells (no predecessor) are no longer allowed, and the rows after the frontier up to `t`
@@ -182,6 +185,79 @@ impl State<'_> {
         best.0.is_finite().then_some(best.1)
     }
 
+    /// The decision at frame `t`: the best chain explaining frames `0..=t` given the committed
+    /// prefix, as the offline DP would answer for an input that stopped at `t` — its last segment
+    /// either ends at `t` (row `t`) or, with partial ends, overhangs `t` (a cell starting at
+    /// `s ∈ (t − d, t)`, scored on its in-range samples with the `(d+1)/#in-range` scaling). That
+    /// last segment is returned apart: its end is no decision yet. Returns the chain before it
+    /// (time order, back to the frontier) or `None` when no chain reaches `t`. Ties: cells ending
+    /// at `t` first (lowest column), then overhanging cells by start, column and predecessor
+    /// column (strict `<`). Overhanging cells are evaluated in parallel over columns, each by one
+    /// task, and reduced in that fixed order, so the decision does not depend on the thread count.
+    fn decide(&self, t: usize, frontier: Option<(usize, usize)>) -> Option<Vec<(usize, i64)>> {
+        let np = self.np;
+        let kt = self.kt;
+        // The best candidate so far: (score, chain before its last segment).
+        let mut best: Option<(f64, Vec<(usize, i64)>)> = self.best_in_row(t).map(|c| {
+            let mut chain = self.trace(t, c, frontier);
+            chain.pop();
+            (self.q[t * np + c], chain)
+        });
+        if !self.p.partial_ends {
+            return best.map(|b| b.1);
+        }
+        let dmax = self.cols.iter().map(|c| c.d).max().unwrap_or(1) as i64;
+        let w0 = (t as i64 - dmax).max(0) as usize;
+        let xw = self.x.window(w0, t);
+        let wc = &self.db.control_weights;
+        let wt = &self.db.target_weights;
+        for s in (t as i64 - dmax + 1).max(self.s_lo)..t as i64 {
+            let base = s <= 0;
+            if base && !self.base_ok {
+                continue;
+            }
+            let live: &[u32] = if base { &[] } else { &self.live[s as usize] };
+            if !base && live.is_empty() {
+                continue;
+            }
+            // Overhanging cells starting at s (in-range part ends at t), per column.
+            let cand: Vec<Option<(f64, u32)>> = self
+                .cols
+                .par_iter()
+                .map(|col| {
+                    if s + col.d as i64 <= t as i64 || excluded(&self.p.forced, col.inst, s, s + col.d as i64) {
+                        return None;
+                    }
+                    let e = eval_cell(&xw, col, s - w0 as i64, wc)?;
+                    if base {
+                        return Some((e.d, u32::MAX));
+                    }
+                    let (mut b, mut arg) = (f64::INFINITY, u32::MAX);
+                    let su = s as usize;
+                    for &r in live {
+                        let slot = (su % self.ring) * np + r as usize;
+                        let om = &self.tails[slot * 2 * kt..(slot + 1) * 2 * kt];
+                        let z = self.q[su * np + r as usize]
+                            + self.p.k * continuity(om, &e.alpha, wt, self.p.continuity_order, self.p.k_vel)
+                            + e.d;
+                        if z < b {
+                            b = z;
+                            arg = r;
+                        }
+                    }
+                    b.is_finite().then_some((b, arg))
+                })
+                .collect();
+            for (v, arg) in cand.into_iter().flatten() {
+                if best.as_ref().is_none_or(|b| v < b.0) {
+                    let chain = if arg == u32::MAX { vec![] } else { self.trace(s as usize, arg as usize, frontier) };
+                    best = Some((v, chain));
+                }
+            }
+        }
+        best.map(|b| b.1)
+    }
+
     /// The chain ending at cell `(t, c)` back to (excluding) the frontier cell, in time order, as
     /// (column, start).
     fn trace(&self, t: usize, c: usize, frontier: Option<(usize, usize)>) -> Vec<(usize, i64)> {
@@ -248,12 +324,11 @@ pub fn interpret_streaming(db: &MappingDb, x: &PointTrack, p: &DpParams, lag: us
         if f < 0 || f <= committed_until || t as i64 == t_len - 1 {
             continue;
         }
-        let Some(c) = st.best_in_row(t) else { continue };
-        let chain = st.trace(t, c, frontier);
-        // The last segment ends at t only because the chain was cut there: its end is no decision
-        // yet, so it is never committed. Commit up to and including the segment covering frame
-        // f, or, when that is the last one, every segment before it.
-        let body = chain.len().saturating_sub(1);
+        // The chain explaining 0..=t without its last segment (which is cut at t, so its end is
+        // no decision yet, and is never committed). Commit up to and including the segment
+        // covering frame f, or, when f lies in the last one, every segment before it.
+        let Some(chain) = st.decide(t, frontier) else { continue };
+        let body = chain.len();
         let upto = chain[..body]
             .iter()
             .position(|&(col, start)| start + st.cols[col].d as i64 >= f)

@@ -32,6 +32,12 @@ fn walk_pc1() {
         assert!(check(&r, key), "{key} = {}", r.get_f64(key));
     }
     assert!(r.get_f64("db_instances") <= r.get_f64("db_instances_before"));
+    // The streaming DP beside the offline one: an agreement in [0, 1], never a better score, a
+    // measured latency of at least the lag.
+    let agree = r.get_f64("streaming_label_agreement");
+    assert!((0.0..=1.0).contains(&agree), "streaming agreement {agree}");
+    assert!(r.get_f64("streaming_score_excess_rel") >= -1e-12);
+    assert!(r.get_f64("streaming_latency_s") >= r.get_f64("streaming_lag_s") - 1e-12);
 }
 
 #[test]
@@ -57,15 +63,34 @@ fn mouse_paths_pc3() {
     assert!(r.get_f64("fast_d_per_frame") > r.get_f64("d_per_frame_mean"), "the 6 m/s stroke is explained worse");
 }
 
+fn real_data(name: &str) -> Report {
+    let mut p: real_data::Params = load_params(&scene(name)).unwrap();
+    p.resolve_paths(&root().join("scenes/perf-control"));
+    tests::assert_thread_independent(name, || real_data::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap())
+}
+
 #[test]
 fn real_data_pc6() {
-    let mut p: real_data::Params = load_params(&scene("real-data")).unwrap();
-    p.resolve_paths(&root().join("scenes/perf-control"));
-    let r = tests::assert_thread_independent("real-data", || {
-        real_data::run(&p, Size::Tiny, &mut NullRecorder::default()).unwrap()
-    });
+    let r = real_data("real-data");
     assert!(r.get_f64("segments_detected") > 10.0);
-    assert!(r.get_f64("mid_rms_m").is_finite());
+    for key in ["mid_rms_m", "phase_agreement", "stride_ratio", "skate_cm_s"] {
+        assert!(r.get_f64(key).is_finite(), "{key} = {}", r.get_f64(key));
+    }
+    // The converter's T-pose (frame 0) is far from the clips' median pose and is dropped.
+    for clip in ["01_01", "01_03"] {
+        assert!(r.get_f64(&format!("setup_dropped_frames_{clip}")) >= 1.0, "{clip}");
+        assert!(r.get_f64(&format!("setup_frame0_pose_dist_m_{clip}")) > 0.3, "{clip}");
+    }
+}
+
+#[test]
+fn real_data_cross_clip_pc6() {
+    let r = real_data("real-data-cross-clip");
+    assert!(r.get_f64("segments_detected") > 10.0);
+    assert!(r.get_f64("setup_dropped_frames_01_03") >= 1.0);
+    for key in ["mid_rms_m", "heading_rms_deg", "phase_agreement", "stride_ratio", "skate_cm_s"] {
+        assert!(r.get_f64(key).is_finite(), "{key} = {}", r.get_f64(key));
+    }
 }
 
 #[test]

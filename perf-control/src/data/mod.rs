@@ -1,6 +1,7 @@
 //! Procedural example data (spec §3.13): walks from geom-core's synthesiser with an exact
 //! segmentation at foot plants, mouse-like paths, and the Lindy-like duet ([`duet`]).
 
+pub mod capture;
 pub mod duet;
 pub mod mouse;
 pub mod walk;

@@ -31,7 +31,7 @@ use crate::reduce::{ClusterBy, ClusterDistance, ClusterOptions, Representative};
 use crate::refine::refine;
 use crate::track::PointTrack;
 use crate::{hips_control, tracking_error};
-use geom_core::clock::thread_cpu_s;
+use geom_core::clock::process_cpu_s;
 
 /// The walk sweeps' data: a database take (120 s, 40 s quick) and a held-out input (57 s, 20 s
 /// quick), both at 30 Hz.
@@ -153,7 +153,7 @@ impl DanceSweep {
 pub struct DanceSweepPoint {
     /// DP wall time (s).
     pub dp_s: f64,
-    /// DP CPU time of the thread (s).
+    /// DP CPU time of the process, every thread (s).
     pub dp_cpu_s: f64,
     /// DP score `S` (m²).
     pub score: f64,
@@ -171,9 +171,9 @@ pub struct DanceSweepPoint {
 /// built at ±0.15 s).
 pub fn evaluate_dance(s: &DanceSweep, p: &DpParams) -> Result<DanceSweepPoint> {
     let x = s.x_fine.downsample(s.factor);
-    let (t0, c0) = (Instant::now(), thread_cpu_s());
+    let (t0, c0) = (Instant::now(), process_cpu_s());
     let it = interpret(&s.db.db, &x, p)?;
-    let (dp_s, dp_cpu_s) = (t0.elapsed().as_secs_f64(), thread_cpu_s() - c0);
+    let (dp_s, dp_cpu_s) = (t0.elapsed().as_secs_f64(), process_cpu_s() - c0);
     let labels = segment_labels(&s.db.db, &it, &s.truth);
     let errors = labels.iter().zip(&s.truth.segments).filter(|(o, t)| **o != Some(t.2)).count();
     Ok(DanceSweepPoint {

@@ -1,9 +1,14 @@
 //! PC-1 (spec §6): a walk database (one generated 120 s take, segmented at every foot plant,
 //! clustered to 70 instances) driven by the hips control of held-out walks, 60 s ("long") and
 //! 10 s ("short"). Figures per kind: midpoint tracking RMS and max, heading RMS, stride frequency
-//! ratio, phase agreement with the true walk, foot skate, DP time.
+//! ratio, phase agreement with the true walk, foot skate, DP time. Beside the offline DP, the
+//! fixed-lag streaming DP ([`crate::stream`], spec §13) interprets every input with the lag
+//! `streaming_lag_s`: its label agreement with the offline chain per working frame (the walk's
+//! labels are the steps' lead feet), score excess and measured latency (the longest wait of a
+//! frame for its commit).
 //!
-//! Outputs: tables `metrics` (one row per input), `timing`, `segments` and `target_points`
+//! Outputs: tables `metrics` (one row per input), `timing`, `streaming` (one row per input and
+//! lag), `segments` and `target_points`
 //! (first input), plot `topview` (requested vs achieved hips midpoint of the first input), file
 //! `target.bvh` (first input).
 //!
@@ -31,11 +36,13 @@ use crate::data::walk::HIP_WIDTH;
 use crate::data::walk_motion;
 use crate::dp::DpParams;
 use crate::error::Result;
+use crate::eval::dance::frame_labels;
 use crate::eval::{phase_agreement, seam_frames, seam_jumps, step_frequency, tracking_error};
 use crate::experiments::common::{record_segments, record_target_points, topview};
 use crate::output::target_points;
 use crate::pipeline::drive;
 use crate::presets::{walk_database, WalkDbParams};
+use crate::stream::interpret_streaming;
 use crate::{hips_control, TrackingStats};
 
 /// Parameters of PC-1 (the RON `params` block of `perf-control/walk`).
@@ -58,6 +65,9 @@ pub struct Params {
     pub short_count: BySize<usize>,
     /// Short input length (s).
     pub short_secs: f64,
+    /// Lag of the streaming DP run beside the offline DP (s; none when omitted).
+    #[serde(default)]
+    pub streaming_lag_s: Option<f64>,
 }
 
 const METRICS: [&str; 15] = [
@@ -92,7 +102,13 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         .collect();
     rec.table("metrics", &METRICS)?;
     rec.table("timing", &["kind", "seed", "input_s", "dp_s", "refine_s", "post_s"])?;
+    rec.table(
+        "streaming",
+        &["kind", "seed", "lag_s", "label_agreement", "score_excess_rel", "latency_max_s", "latency_median_s"],
+    )?;
     let mut agg: BTreeMap<&str, Vec<[f64; 7]>> = BTreeMap::new();
+    // Streaming: (agreeing frames, frames, score excess, measured latency) per kind.
+    let mut sagg: BTreeMap<&str, Vec<[f64; 4]>> = BTreeMap::new();
     for (idx, &(kind, seed, secs)) in inputs.iter().enumerate() {
         rec.progress(idx as u64, inputs.len() as u64);
         let truth = walk_motion(seed, secs, p.database.native_hz);
@@ -130,6 +146,28 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
             &[kind.into(), Cell::Int(seed as i64), secs.into(), d.dp_s.into(), d.refine_s.into(), d.post_s.into()],
         )?;
         agg.entry(kind).or_default().push([tr.rms_m, tr.max_m, tr.heading_rms_deg, stride, phase, skate, d.dp_s]);
+        if let Some(lag_s) = p.streaming_lag_s {
+            let x = x_fine.downsample(u);
+            let lag = (lag_s * x.rate_hz).floor() as usize;
+            let s = interpret_streaming(&w.db, &x, &p.dp, lag)?;
+            let (a, b) = (frame_labels(&w.db, &s.it), frame_labels(&w.db, &d.coarse));
+            let agree = a.iter().zip(&b).filter(|(x, y)| x == y).count() as f64;
+            let frames = a.len().min(b.len()) as f64;
+            let excess = (s.it.score - d.coarse.score) / d.coarse.score;
+            rec.row(
+                "streaming",
+                &[
+                    kind.into(),
+                    Cell::Int(seed as i64),
+                    s.latency_s.into(),
+                    (agree / frames).into(),
+                    excess.into(),
+                    s.latency_max_s.into(),
+                    s.latency_median_s.into(),
+                ],
+            )?;
+            sagg.entry(kind).or_default().push([agree, frames, excess, s.latency_max_s]);
+        }
         if idx == 0 {
             record_segments(rec, &w.db, &d.coarse, &d.fine)?;
             topview(rec, &x_fine, &achieved)?;
@@ -155,6 +193,20 @@ pub fn run(p: &Params, size: Size, rec: &mut dyn Recorder) -> Result<Report> {
         r.num(&format!("{kind}_skate_cm_s"), mean(&col(5)));
         r.timing(&format!("{kind}_dp_s"), mean(&col(6)));
         r.count(&format!("{kind}_inputs"), rows.len() as u64);
+    }
+    if let Some(lag_s) = p.streaming_lag_s {
+        let all: Vec<[f64; 4]> = sagg.values().flatten().copied().collect();
+        let agreement =
+            |rows: &[[f64; 4]]| rows.iter().map(|r| r[0]).sum::<f64>() / rows.iter().map(|r| r[1]).sum::<f64>();
+        for (kind, rows) in &sagg {
+            r.num(&format!("{kind}_streaming_label_agreement"), agreement(rows));
+        }
+        r.num("streaming_lag_s", lag_s);
+        r.num("streaming_label_agreement", agreement(&all));
+        r.num("streaming_latency_s", max(&all.iter().map(|r| r[3]).collect::<Vec<f64>>()));
+        r.num("streaming_score_excess_rel", mean(&all.iter().map(|r| r[2]).collect::<Vec<f64>>()));
+        r.check("streaming_label_agreement", Target::AtLeast(0.95), "issue 27: fixed-lag streaming DP in PC-1");
+        r.check("streaming_latency_s", Target::AtMost(1.0), "issue 27: fixed-lag streaming DP in PC-1");
     }
     for kind in agg.keys() {
         let src = "PC-1 (spec §6): tracking of held-out walks";
