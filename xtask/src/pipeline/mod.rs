@@ -11,6 +11,7 @@
 //! with the body (`*_body/`), and `summary.json` with each stage's wall time.
 
 mod body;
+mod body_strain;
 mod garment;
 mod simulate;
 
@@ -135,6 +136,16 @@ pub fn run(ctx: &RunCtx, p: &Params, size: Size, rec: &mut dyn Recorder) -> Resu
     }
     garment::attach_to_body(&c, &g, &body_frames, &mut guide)?;
     r.timing("skin_s", t0.elapsed().as_secs_f64());
+    let bs = body_strain::measure(&c.mesh, &body_frames);
+    r.num("body_max_edge_strain", bs.max).num("body_max_edge_strain_t_s", bs.frame as f64 / p.fps);
+    let who = |v| body_strain::describe_vertex(v, &c.weights, &c.skeleton);
+    rec.note(&format!(
+        "body: largest edge strain {:.3} at t = {:.3} s on edge {} – {}",
+        bs.max,
+        bs.frame as f64 / p.fps,
+        who(bs.edge[0]),
+        who(bs.edge[1])
+    ))?;
     let frames = poses.len();
     r.num("motion_s", (frames - 1) as f64 / p.fps).num("clip_motion_s", (frames - 1) as f64 / p.fps - settle);
     // The animated character as glTF.
